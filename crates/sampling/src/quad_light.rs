@@ -1,0 +1,429 @@
+//! Sampling directions toward a one-sided parallelogram light
+//! `corner + s edge_u + t edge_v`, `(s, t)` in `[0, 1]^2`, emitting on the side
+//! of `edge_u x edge_v`.
+//!
+//! Two strategies: uniform area sampling with its pdf converted to solid
+//! angle, and Ureña et al.'s spherical-rectangle sampling, whose pdf is
+//! constant in solid angle (for rectangles only). A shading point behind the
+//! emitting side, or on the light's plane, gets no sample and pdf 0.
+
+use std::f64::consts::TAU;
+
+use glam::{DVec3, Vec2, Vec3};
+
+use crate::light::DirectionSample;
+use crate::math::{clamp_u2, normalize_with_length};
+use crate::sphere_light::finite_pdf;
+
+/// Unit emitting normal and area of the parallelogram, or `None` if it is
+/// degenerate or not finite.
+#[inline]
+fn normal_and_area(edge_u: Vec3, edge_v: Vec3) -> Option<(Vec3, f32)> {
+    normalize_with_length(edge_u.cross(edge_v))
+}
+
+/// True when `p` is strictly on the emitting side of the plane.
+#[inline]
+fn faces(p: Vec3, corner: Vec3, normal: Vec3) -> bool {
+    p.is_finite() && corner.is_finite() && (p - corner).dot(normal) > 0.0
+}
+
+/// Samples a point uniformly on the parallelogram and returns the direction
+/// to it with the area pdf converted to solid angle,
+/// `pdf = d^2 / (cos(alpha) area)`, where `alpha` is the angle between the
+/// light's normal and `-wi` (pbrt-v4 §4.2.3: `d omega = cos(alpha) dA / d^2`).
+/// `None` when `p` is behind or on the light's plane, or the light is
+/// degenerate.
+pub fn sample_quad_area(
+    p: Vec3,
+    corner: Vec3,
+    edge_u: Vec3,
+    edge_v: Vec3,
+    u: Vec2,
+) -> Option<DirectionSample> {
+    let (normal, area) = normal_and_area(edge_u, edge_v)?;
+    if !faces(p, corner, normal) {
+        return None;
+    }
+    let u = clamp_u2(u);
+    let point = corner + u.x * edge_u + u.y * edge_v;
+    DirectionSample::toward_with(p, point, normal, |wi, distance| {
+        let cos_alpha = -wi.dot(normal);
+        if cos_alpha > 0.0 {
+            distance * distance / (cos_alpha * area)
+        } else {
+            0.0
+        }
+    })
+}
+
+/// Where the ray `(p, wi)` meets the front face of the parallelogram:
+/// `(t, cos_alpha, area)` in f64, or `None` on a miss. The bounds get a
+/// slack of 1e-5 of the edges plus a few f32 ulps of the coordinates'
+/// magnitude, so that a sample on an edge counts as a hit even for a light
+/// 1e-4 wide, whose sampled directions the f32 grid rounds by 1e-3 of its
+/// width (the same reasoning as for the sphere light).
+fn hit_front(
+    p: Vec3,
+    corner: Vec3,
+    edge_u: Vec3,
+    edge_v: Vec3,
+    wi: Vec3,
+) -> Option<(f64, f64, f64)> {
+    let (normal32, _) = normal_and_area(edge_u, edge_v)?;
+    if !faces(p, corner, normal32) || !wi.is_finite() {
+        return None;
+    }
+    let (eu, ev) = (edge_u.as_dvec3(), edge_v.as_dvec3());
+    let n_raw = eu.cross(ev);
+    let area2 = n_raw.length_squared();
+    let area = area2.sqrt();
+    let normal = n_raw / area;
+    let wi = wi.as_dvec3();
+    let len = wi.length();
+    if len <= 0.0 {
+        return None;
+    }
+    let wi = wi / len;
+    let denom = wi.dot(normal);
+    if denom >= 0.0 {
+        return None;
+    }
+    let o = p.as_dvec3();
+    let c = corner.as_dvec3();
+    let t = (c - o).dot(normal) / denom;
+    if t.is_nan() || t <= 0.0 {
+        return None;
+    }
+    let q = o + t * wi - c;
+    // q = a edge_u + b edge_v; cross with the other edge to isolate each.
+    let a = q.cross(ev).dot(n_raw) / area2;
+    let b = eu.cross(q).dot(n_raw) / area2;
+    // A world-space error `e` moves `a` by at most `e |edge_v| / area`.
+    let magnitude = t + f64::from(p.abs().max_element().max(corner.abs().max_element()));
+    let error = 2e-7 * magnitude / area;
+    let inside = |x: f64, slack: f64| (-slack..=1.0 + slack).contains(&x);
+    (inside(a, 1e-5 + error * ev.length()) && inside(b, 1e-5 + error * eu.length()))
+        .then_some((t, -denom, area))
+}
+
+/// Solid-angle pdf with which [`sample_quad_area`] produces `wi` from `p`:
+/// `d^2 / (cos(alpha) area)` at the point where the ray meets the light; 0
+/// when the ray misses, hits the back, or `p` is behind the emitting side.
+pub fn quad_area_pdf(p: Vec3, corner: Vec3, edge_u: Vec3, edge_v: Vec3, wi: Vec3) -> f32 {
+    match hit_front(p, corner, edge_u, edge_v, wi) {
+        Some((t, cos_alpha, area)) => finite_pdf(t * t / (cos_alpha * area)),
+        None => 0.0,
+    }
+}
+
+/// The spherical rectangle subtended by a rectangular light from a point, for
+/// sampling with a constant solid-angle pdf.
+///
+/// Ureña, Fajardo and King 2013, "An Area-Preserving Parametrization for
+/// Spherical Rectangles", EGSR, Algorithm 1 (also pbrt-v4
+/// `SampleSphericalRectangle`). Computed in f64: the solid angle is
+/// `g0 + g1 + g2 + g3 - 2pi`, a sum of interior angles that cancels badly for
+/// small rectangles, and the interior angles are taken with `atan2` rather than
+/// the paper's `acos`, which is ill-conditioned at grazing views.
+#[derive(Clone, Copy, Debug)]
+pub struct SphericalRectangle {
+    o: DVec3,
+    x: DVec3,
+    y: DVec3,
+    z: DVec3,
+    z0: f64,
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
+    b0: f64,
+    b1: f64,
+    k: f64,
+    solid_angle: f64,
+    normal: Vec3,
+}
+
+impl SphericalRectangle {
+    /// Below this solid angle (steradians) [`SphericalRectangle::new`] declines:
+    /// the f64 cancellation in the interior-angle sum would reach 1e-6 of the
+    /// result. Area sampling is near-optimal there anyway: the light is so small
+    /// or far that its area-to-solid-angle factor is nearly constant.
+    pub const MIN_SOLID_ANGLE: f32 = 1e-9;
+
+    /// Largest `|cos|` of the angle between the edges accepted as a rectangle.
+    pub const RECTANGLE_TOLERANCE: f32 = 1e-4;
+
+    /// The spherical rectangle of the light seen from `p`. `None` when the
+    /// edges are not perpendicular (within [`Self::RECTANGLE_TOLERANCE`]) or
+    /// degenerate, when `p` is behind or on the light's plane, or when the
+    /// solid angle is below [`Self::MIN_SOLID_ANGLE`] (use
+    /// [`sample_quad_area`] then; [`sample_quad_solid_angle`] does this
+    /// fallback for you).
+    pub fn new(p: Vec3, corner: Vec3, edge_u: Vec3, edge_v: Vec3) -> Option<Self> {
+        if !(p.is_finite() && corner.is_finite() && edge_u.is_finite() && edge_v.is_finite()) {
+            return None;
+        }
+        let (normal, _) = normal_and_area(edge_u, edge_v)?;
+        let (ex, ey) = (edge_u.as_dvec3(), edge_v.as_dvec3());
+        let (exl, eyl) = (ex.length(), ey.length());
+        if !(exl > 0.0 && eyl > 0.0) {
+            return None;
+        }
+        let x = ex / exl;
+        let y = ey / eyl;
+        if x.dot(y).abs() > f64::from(Self::RECTANGLE_TOLERANCE) {
+            return None;
+        }
+        let z = x.cross(y).normalize();
+        let y = z.cross(x);
+        let o = p.as_dvec3();
+        let d = corner.as_dvec3() - o;
+        let z0 = d.dot(z);
+        // The emitting side is +z; p must be strictly in front, i.e. the
+        // rectangle lies at z0 < 0 in the local frame, as the paper requires.
+        if z0.is_nan() || z0 >= 0.0 {
+            return None;
+        }
+        let x0 = d.dot(x);
+        let y0 = d.dot(y);
+        let x1 = x0 + exl;
+        let y1 = y0 + ey.dot(y);
+        // Vertices in the local frame and the normals of the great circles
+        // through consecutive vertices (Ureña et al. 2013, Algorithm 1).
+        let v00 = DVec3::new(x0, y0, z0);
+        let v01 = DVec3::new(x0, y1, z0);
+        let v10 = DVec3::new(x1, y0, z0);
+        let v11 = DVec3::new(x1, y1, z0);
+        let n0 = v00.cross(v10).normalize();
+        let n1 = v10.cross(v11).normalize();
+        let n2 = v11.cross(v01).normalize();
+        let n3 = v01.cross(v00).normalize();
+        // Interior angle between consecutive edges: acos(-n_i . n_j), written
+        // as atan2(|n_i x n_j|, -n_i . n_j) for accuracy near 0 and pi.
+        let angle = |a: DVec3, b: DVec3| a.cross(b).length().atan2(-a.dot(b));
+        let g0 = angle(n0, n1);
+        let g1 = angle(n1, n2);
+        let g2 = angle(n2, n3);
+        let g3 = angle(n3, n0);
+        let k = TAU - g2 - g3;
+        let solid_angle = g0 + g1 - k;
+        if !(solid_angle.is_finite() && solid_angle >= f64::from(Self::MIN_SOLID_ANGLE)) {
+            return None;
+        }
+        Some(Self {
+            o,
+            x,
+            y,
+            z,
+            z0,
+            x0,
+            y0,
+            x1,
+            y1,
+            b0: n0.z,
+            b1: n2.z,
+            k,
+            solid_angle,
+            normal,
+        })
+    }
+
+    /// Solid angle of the rectangle seen from the shading point, in sr.
+    pub fn solid_angle(&self) -> f32 {
+        self.solid_angle as f32
+    }
+
+    /// The constant solid-angle pdf `1 / solid_angle` of [`Self::sample`] for
+    /// directions that hit the rectangle (finite: the solid angle is at least
+    /// [`Self::MIN_SOLID_ANGLE`]).
+    pub fn pdf(&self) -> f32 {
+        (1.0 / self.solid_angle) as f32
+    }
+
+    /// Samples a direction uniformly in solid angle over the rectangle
+    /// (Ureña et al. 2013, Algorithm 1, "sample"): `u.x` picks the
+    /// sub-rectangle `[x0, xu]` with solid angle `u.x S`, `u.y` picks the
+    /// height along the resulting vertical edge uniformly in the projected
+    /// coordinate `h`. `None` only if rounding defeats the invariant of
+    /// [`DirectionSample`].
+    pub fn sample(&self, u: Vec2) -> Option<DirectionSample> {
+        let u = clamp_u2(u).as_dvec2();
+        let au = u.x * self.solid_angle + self.k;
+        let fu = (au.cos() * self.b0 - self.b1) / au.sin();
+        let cu = (1.0 / (fu * fu + self.b0 * self.b0).sqrt()).copysign(fu);
+        // Keep away from +-1 so that sqrt(1 - cu^2) is not 0 (pbrt-v4 does the
+        // same); then clamp xu into the rectangle.
+        let cu = cu.clamp(-1.0 + f64::EPSILON, 1.0 - f64::EPSILON);
+        let xu = (-(cu * self.z0) / (1.0 - cu * cu).sqrt()).clamp(self.x0, self.x1);
+        let d = (xu * xu + self.z0 * self.z0).sqrt();
+        let h0 = self.y0 / (d * d + self.y0 * self.y0).sqrt();
+        let h1 = self.y1 / (d * d + self.y1 * self.y1).sqrt();
+        let hv = h0 + u.y * (h1 - h0);
+        let hv2 = hv * hv;
+        let yv = if hv2 < 1.0 - 1e-12 {
+            (hv * d / (1.0 - hv2).sqrt()).clamp(self.y0, self.y1)
+        } else {
+            self.y1
+        };
+        let local = xu * self.x + yv * self.y + self.z0 * self.z;
+        let distance = local.length();
+        let sample = DirectionSample {
+            wi: (local / distance).as_vec3(),
+            distance: distance as f32,
+            pdf: self.pdf(),
+            point: (self.o + local).as_vec3(),
+            normal: self.normal,
+        };
+        let ok = sample.wi.is_finite()
+            && sample.point.is_finite()
+            && sample.distance.is_finite()
+            && sample.distance > 0.0
+            && sample.pdf.is_finite()
+            && sample.pdf > 0.0;
+        ok.then_some(sample)
+    }
+}
+
+/// Samples a quad light by solid angle where that is possible and accurate
+/// (a rectangle whose [`SphericalRectangle`] exists), else by area
+/// ([`sample_quad_area`]). Pair it with [`quad_solid_angle_pdf`].
+pub fn sample_quad_solid_angle(
+    p: Vec3,
+    corner: Vec3,
+    edge_u: Vec3,
+    edge_v: Vec3,
+    u: Vec2,
+) -> Option<DirectionSample> {
+    match SphericalRectangle::new(p, corner, edge_u, edge_v) {
+        Some(rectangle) => rectangle.sample(u),
+        None => sample_quad_area(p, corner, edge_u, edge_v, u),
+    }
+}
+
+/// Solid-angle pdf with which [`sample_quad_solid_angle`] produces `wi`: the
+/// same choice of strategy, and 0 when the ray misses the front of the light.
+pub fn quad_solid_angle_pdf(p: Vec3, corner: Vec3, edge_u: Vec3, edge_v: Vec3, wi: Vec3) -> f32 {
+    match SphericalRectangle::new(p, corner, edge_u, edge_v) {
+        Some(rectangle) => {
+            if hit_front(p, corner, edge_u, edge_v, wi).is_some() {
+                rectangle.pdf()
+            } else {
+                0.0
+            }
+        }
+        None => quad_area_pdf(p, corner, edge_u, edge_v, wi),
+    }
+}
+
+/// Irradiance at `p` with unit normal `n` from a polygon of unit radiance
+/// (vertices in order, all above the shading plane), by Lambert's formula
+/// `E = 1/2 sum_i Theta_i (gamma_i . n)`, where `Theta_i` is the angle edge `i`
+/// subtends at `p` and `gamma_i` the unit normal of the plane through `p` and
+/// that edge (Arvo 1995, "Applications of Irradiance Tensors to the
+/// Simulation of Non-Lambertian Phenomena", SIGGRAPH). A light covering the
+/// whole hemisphere gives `pi`; divide by `pi` for the form factor. A
+/// closed-form reference for tests of light sampling.
+pub fn polygon_irradiance(p: Vec3, n: Vec3, vertices: &[Vec3]) -> f32 {
+    let n = n.as_dvec3();
+    let o = p.as_dvec3();
+    let mut sum = 0.0;
+    for (i, a) in vertices.iter().enumerate() {
+        let b = vertices[(i + 1) % vertices.len()];
+        let va = (a.as_dvec3() - o).normalize();
+        let vb = (b.as_dvec3() - o).normalize();
+        let c = va.cross(vb);
+        let length = c.length();
+        if length > 0.0 {
+            let angle = length.atan2(va.dot(vb));
+            sum += angle * (c / length).dot(n);
+        }
+    }
+    // The sign depends on the winding; irradiance is non-negative.
+    (0.5 * sum).abs() as f32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::ONE_MINUS_EPSILON;
+
+    const CORNER: Vec3 = Vec3::new(-0.5, -0.25, 1.0);
+    const EU: Vec3 = Vec3::new(1.0, 0.0, 0.0);
+    // edge_u x edge_v = -z: the light faces down toward the origin.
+    const EV: Vec3 = Vec3::new(0.0, -0.75, 0.0);
+
+    #[test]
+    fn area_and_solid_angle_samples_hit_the_light_with_consistent_pdfs() {
+        let p = Vec3::new(0.1, 0.2, -0.3);
+        let rect = SphericalRectangle::new(p, CORNER, EU, EV).unwrap();
+        for &a in &[0.0, 0.3, 0.77, ONE_MINUS_EPSILON] {
+            for &b in &[0.0, 0.5, ONE_MINUS_EPSILON] {
+                let u = Vec2::new(a, b);
+                let s = sample_quad_area(p, CORNER, EU, EV, u).unwrap();
+                let pdf = quad_area_pdf(p, CORNER, EU, EV, s.wi);
+                assert!((pdf - s.pdf).abs() <= 1e-4 * s.pdf, "{pdf} vs {}", s.pdf);
+                let s = rect.sample(u).unwrap();
+                assert!((s.point.z - 1.0).abs() < 1e-6);
+                assert!((-0.5 - 1e-5..=0.5 + 1e-5).contains(&s.point.x));
+                assert!((-1.0 - 1e-5..=-0.25 + 1e-5).contains(&s.point.y));
+                assert_eq!(quad_solid_angle_pdf(p, CORNER, EU, EV, s.wi), rect.pdf());
+            }
+        }
+    }
+
+    #[test]
+    fn back_facing_and_coplanar_points_get_nothing() {
+        let u = Vec2::splat(0.5);
+        for p in [Vec3::new(0.0, 0.0, 2.0), Vec3::new(3.0, 0.0, 1.0)] {
+            assert!(sample_quad_area(p, CORNER, EU, EV, u).is_none());
+            assert!(SphericalRectangle::new(p, CORNER, EU, EV).is_none());
+            assert_eq!(quad_area_pdf(p, CORNER, EU, EV, -Vec3::Z), 0.0);
+        }
+        // The ray misses, or leaves the front side away from the light.
+        assert_eq!(quad_area_pdf(Vec3::ZERO, CORNER, EU, EV, Vec3::X), 0.0);
+        assert_eq!(quad_area_pdf(Vec3::ZERO, CORNER, EU, EV, -Vec3::Z), 0.0);
+    }
+
+    #[test]
+    fn tiny_solid_angles_fall_back_to_area_sampling() {
+        // 1e-5 x 1e-5 at distance ~1: about 1e-10 sr, below the threshold.
+        let (corner, eu, ev) = (Vec3::new(0.0, 0.0, 1.0), 1e-5 * Vec3::X, -1e-5 * Vec3::Y);
+        assert!(SphericalRectangle::new(Vec3::ZERO, corner, eu, ev).is_none());
+        let s = sample_quad_solid_angle(Vec3::ZERO, corner, eu, ev, Vec2::splat(0.5)).unwrap();
+        let area = sample_quad_area(Vec3::ZERO, corner, eu, ev, Vec2::splat(0.5)).unwrap();
+        assert_eq!(s, area);
+        assert_eq!(
+            quad_solid_angle_pdf(Vec3::ZERO, corner, eu, ev, s.wi),
+            quad_area_pdf(Vec3::ZERO, corner, eu, ev, s.wi)
+        );
+        // Just above the threshold the spherical rectangle exists.
+        let (eu, ev) = (1e-4 * Vec3::X, -1e-4 * Vec3::Y);
+        let rect = SphericalRectangle::new(Vec3::ZERO, corner, eu, ev).unwrap();
+        assert!((rect.solid_angle() - 1e-8).abs() < 1e-11);
+    }
+
+    #[test]
+    fn non_rectangles_are_declined() {
+        let skew = Vec3::new(0.3, -0.75, 0.0);
+        assert!(SphericalRectangle::new(Vec3::ZERO, CORNER, EU, skew).is_none());
+        // The combined sampler falls back to area sampling.
+        let s = sample_quad_solid_angle(Vec3::ZERO, CORNER, EU, skew, Vec2::splat(0.3)).unwrap();
+        assert_eq!(
+            quad_solid_angle_pdf(Vec3::ZERO, CORNER, EU, skew, s.wi),
+            quad_area_pdf(Vec3::ZERO, CORNER, EU, skew, s.wi)
+        );
+    }
+
+    #[test]
+    fn solid_angle_matches_closed_form_for_a_square_overhead() {
+        // A unit square at height 1 centred above p: solid angle is
+        // 4 asin(1/5) (closed form for a rectangle 2a x 2b at distance d:
+        // 4 asin(ab / sqrt((a^2 + d^2)(b^2 + d^2)))).
+        let rect =
+            SphericalRectangle::new(Vec3::ZERO, Vec3::new(-0.5, 0.5, 1.0), Vec3::X, -Vec3::Y)
+                .unwrap();
+        let expected = 4.0 * (0.25f64 / 1.25).asin();
+        assert!((f64::from(rect.solid_angle()) - expected).abs() < 1e-6);
+    }
+}
