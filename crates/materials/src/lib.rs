@@ -1,1 +1,263 @@
-//! placeholder
+//! Surface scattering for lueur: the Lambertian and mirror BSDFs and what
+//! an emitter gives off.
+//!
+//! The primary type is [`Material`], a closed enum: shading dispatches with a
+//! `match`, never a virtual call, because it runs once per path vertex. A BSDF
+//! is queried in a world frame given the shading normal `n`; every direction
+//! (`wo` toward the viewer, `wi` toward the light) points away from the
+//! surface.
+//!
+//! Contract: `eval` returns the BSDF value `f(wo, wi)` (not multiplied by the
+//! cosine), `pdf` the solid-angle density with which `sample` produces `wi`,
+//! and a [`BsdfSample`] never carries a NaN or an infinity. A delta lobe (the
+//! mirror) is sampled only: it evaluates to zero and has zero pdf for any
+//! given direction, since a direction chosen by anything else hits it with
+//! probability zero.
+//!
+//! This crate deliberately knows nothing of lights' geometry, scenes or rays:
+//! light sampling lives in `lueur-sampling` and the estimators that combine
+//! both live in `lueur-integrator`.
+//!
+//! ```
+//! use lueur_materials::{HemisphereSampling, Material};
+//! use glam::{Vec2, Vec3};
+//!
+//! let white = Material::Lambertian { albedo: Vec3::splat(0.5) };
+//! let n = Vec3::Z;
+//! let wo = Vec3::new(0.0, 0.6, 0.8);
+//! let s = white
+//!     .sample(wo, n, Vec2::new(0.3, 0.7), HemisphereSampling::Cosine)
+//!     .expect("a Lambertian surface always scatters");
+//! // With cosine sampling the throughput of a Lambertian bounce is the albedo.
+//! assert!((s.weight(n) - Vec3::splat(0.5)).abs().max_element() < 1e-5);
+//! ```
+#![deny(missing_docs)]
+
+use glam::{Vec2, Vec3};
+use lueur_sampling::{
+    Frame, cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere,
+    uniform_hemisphere_pdf,
+};
+use std::f32::consts::FRAC_1_PI;
+
+/// How a diffuse lobe picks its directions: the integrator's strategy
+/// decides, since comparing them is the point of lueur.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HemisphereSampling {
+    /// Uniform over the hemisphere, pdf 1/(2 pi): the report's first sampler.
+    Uniform,
+    /// Proportional to the cosine, pdf cos/pi: the Lambertian BSDF's own shape.
+    Cosine,
+}
+
+/// A surface's response to light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Material {
+    /// Ideal diffuse reflector, BRDF = albedo / pi.
+    Lambertian {
+        /// Fraction of incident power reflected, per RGB channel.
+        albedo: Vec3,
+    },
+    /// Perfect specular reflection, a delta lobe.
+    Mirror {
+        /// Multiplies the reflected radiance, per RGB channel.
+        reflectance: Vec3,
+    },
+}
+
+/// A direction chosen by a BSDF, with what it carries.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// Sampled incident direction (world frame, unit length, away from the surface).
+    pub wi: Vec3,
+    /// BSDF value `f(wo, wi)`; for a delta lobe, the reflectance itself
+    /// (pbrt folds the 1/cos into the delta; we fold the whole throughput).
+    pub f: Vec3,
+    /// Solid-angle pdf of `wi`; 1 by convention for a delta lobe.
+    pub pdf: f32,
+    /// Whether `wi` came from a delta lobe (never evaluated nor light-sampled).
+    pub is_delta: bool,
+}
+
+impl BsdfSample {
+    /// The path throughput factor `f |cos| / pdf` this sample contributes.
+    pub fn weight(&self, n: Vec3) -> Vec3 {
+        if self.is_delta {
+            self.f
+        } else {
+            self.f * n.dot(self.wi).abs() / self.pdf
+        }
+    }
+}
+
+impl Material {
+    /// Whether every lobe is a delta (no light sampling can help here).
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Material::Mirror { .. })
+    }
+
+    /// BSDF value for the pair of directions; zero for delta lobes and for
+    /// directions on opposite sides of the surface.
+    pub fn eval(&self, wo: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
+        match *self {
+            Material::Lambertian { albedo } => {
+                if same_hemisphere(wo, wi, n) {
+                    albedo * FRAC_1_PI
+                } else {
+                    Vec3::ZERO
+                }
+            }
+            Material::Mirror { .. } => Vec3::ZERO,
+        }
+    }
+
+    /// Solid-angle pdf with which [`Material::sample`] returns `wi`.
+    pub fn pdf(&self, wo: Vec3, wi: Vec3, n: Vec3, hemisphere: HemisphereSampling) -> f32 {
+        match *self {
+            Material::Lambertian { .. } => {
+                if !same_hemisphere(wo, wi, n) {
+                    return 0.0;
+                }
+                match hemisphere {
+                    HemisphereSampling::Uniform => uniform_hemisphere_pdf(),
+                    HemisphereSampling::Cosine => cosine_hemisphere_pdf(n.dot(wi).abs()),
+                }
+            }
+            Material::Mirror { .. } => 0.0,
+        }
+    }
+
+    /// Chooses an incident direction from two uniform numbers. `None` when
+    /// the sample carries no weight (a grazing direction with zero pdf).
+    pub fn sample(
+        &self,
+        wo: Vec3,
+        n: Vec3,
+        u: Vec2,
+        hemisphere: HemisphereSampling,
+    ) -> Option<BsdfSample> {
+        // Scatter on the side `wo` is on: surfaces are two-sided.
+        let n = if n.dot(wo) < 0.0 { -n } else { n };
+        match *self {
+            Material::Lambertian { albedo } => {
+                let local = match hemisphere {
+                    HemisphereSampling::Uniform => sample_uniform_hemisphere(u),
+                    HemisphereSampling::Cosine => sample_cosine_hemisphere(u),
+                };
+                let pdf = match hemisphere {
+                    HemisphereSampling::Uniform => uniform_hemisphere_pdf(),
+                    HemisphereSampling::Cosine => cosine_hemisphere_pdf(local.z),
+                };
+                if !(pdf > 0.0) || local.z <= 0.0 {
+                    return None;
+                }
+                let wi = Frame::from_normal(n).to_world(local).normalize();
+                Some(BsdfSample {
+                    wi,
+                    f: albedo * FRAC_1_PI,
+                    pdf,
+                    is_delta: false,
+                })
+            }
+            Material::Mirror { reflectance } => {
+                let wi = reflect(wo, n);
+                Some(BsdfSample {
+                    wi,
+                    f: reflectance,
+                    pdf: 1.0,
+                    is_delta: true,
+                })
+            }
+        }
+    }
+}
+
+/// Mirror reflection of `wo` (pointing away from the surface) about `n`.
+pub fn reflect(wo: Vec3, n: Vec3) -> Vec3 {
+    (2.0 * wo.dot(n) * n - wo).normalize()
+}
+
+fn same_hemisphere(wo: Vec3, wi: Vec3, n: Vec3) -> bool {
+    wo.dot(n) * wi.dot(n) > 0.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lambert() -> Material {
+        Material::Lambertian {
+            albedo: Vec3::new(0.2, 0.5, 0.9),
+        }
+    }
+
+    #[test]
+    fn lambertian_sample_agrees_with_eval_and_pdf() {
+        let n = Vec3::new(0.3, -0.4, 0.5).normalize();
+        let wo = (n + Vec3::X * 0.5).normalize();
+        for hemisphere in [HemisphereSampling::Uniform, HemisphereSampling::Cosine] {
+            for i in 0..64 {
+                let u = Vec2::new((i as f32 + 0.5) / 64.0, ((i * 37 % 64) as f32 + 0.5) / 64.0);
+                let s = lambert().sample(wo, n, u, hemisphere).unwrap();
+                assert!((s.wi.length() - 1.0).abs() < 1e-5);
+                assert!(s.wi.dot(n) > 0.0);
+                assert_eq!(s.f, lambert().eval(wo, s.wi, n));
+                let pdf = lambert().pdf(wo, s.wi, n, hemisphere);
+                assert!((pdf - s.pdf).abs() <= 1e-4 * pdf, "{pdf} vs {}", s.pdf);
+            }
+        }
+    }
+
+    #[test]
+    fn lambertian_is_two_sided_and_zero_across() {
+        let n = Vec3::Z;
+        let wo = Vec3::new(0.0, 0.6, -0.8);
+        let s = lambert()
+            .sample(wo, n, Vec2::new(0.5, 0.5), HemisphereSampling::Cosine)
+            .unwrap();
+        assert!(s.wi.z < 0.0, "scatters on the viewer's side");
+        assert_eq!(lambert().eval(wo, Vec3::Z, n), Vec3::ZERO);
+        assert_eq!(
+            lambert().pdf(wo, Vec3::Z, n, HemisphereSampling::Uniform),
+            0.0
+        );
+    }
+
+    #[test]
+    fn mirror_reflects_and_is_never_evaluated() {
+        let m = Material::Mirror {
+            reflectance: Vec3::splat(0.9),
+        };
+        let n = Vec3::Y;
+        let wo = Vec3::new(1.0, 1.0, 0.0).normalize();
+        let s = m
+            .sample(wo, n, Vec2::ZERO, HemisphereSampling::Cosine)
+            .unwrap();
+        assert!(s.is_delta);
+        assert!((s.wi - Vec3::new(-1.0, 1.0, 0.0).normalize()).length() < 1e-6);
+        assert_eq!(s.weight(n), Vec3::splat(0.9));
+        assert_eq!(m.eval(wo, s.wi, n), Vec3::ZERO);
+        assert_eq!(m.pdf(wo, s.wi, n, HemisphereSampling::Cosine), 0.0);
+    }
+
+    #[test]
+    fn grazing_and_extreme_u_stay_finite() {
+        let n = Vec3::Y;
+        let one = 1.0 - f32::EPSILON / 2.0;
+        for wo in [Vec3::new(1.0, 1e-7, 0.0).normalize(), Vec3::Y] {
+            for u in [
+                Vec2::ZERO,
+                Vec2::splat(one),
+                Vec2::new(0.0, one),
+                Vec2::new(one, 0.0),
+            ] {
+                for h in [HemisphereSampling::Uniform, HemisphereSampling::Cosine] {
+                    if let Some(s) = lambert().sample(wo, n, u, h) {
+                        assert!(s.wi.is_finite() && s.pdf.is_finite() && s.pdf > 0.0);
+                        assert!(s.weight(n).is_finite());
+                    }
+                }
+            }
+        }
+    }
+}
