@@ -1,0 +1,374 @@
+//! The path-tracing estimator of one pixel sample.
+
+use glam::Vec3;
+use lueur_materials::{HemisphereSampling, Material};
+use lueur_sampling::{Sampler, power_heuristic};
+use lueur_sdf_math::{Ray, TraceParams, normal};
+
+use crate::scene::{Hit, Light, Scene, TraceCounters};
+use crate::{RenderSettings, Strategy};
+
+/// Sampler dimensions consumed per path vertex, so that each bounce reads
+/// the same dimensions whatever happened before (low-discrepancy point sets
+/// keep their structure per bounce).
+pub(crate) const DIMS_PER_VERTEX: u32 = 8;
+/// Dimensions before the first vertex: the position in the pixel.
+/// Within a vertex, in order: emitter choice (1), point on the emitter (2),
+/// mixture choice (1), BSDF direction (2), Russian roulette (1), unused (1).
+pub(crate) const CAMERA_DIMS: u32 = 2;
+
+/// Bounces after which Russian roulette may end a path.
+const ROULETTE_DEPTH: u32 = 3;
+
+/// Counters per kind of ray.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounters {
+    /// Rays from the camera.
+    pub camera: TraceCounters,
+    /// Rays continuing a path after a scattering event.
+    pub bounce: TraceCounters,
+    /// Shadow rays of next-event estimation.
+    pub shadow: TraceCounters,
+}
+
+impl RayCounters {
+    /// Adds another set of counters.
+    pub fn merge(&mut self, o: &RayCounters) {
+        self.camera.merge(&o.camera);
+        self.bounce.merge(&o.bounce);
+        self.shadow.merge(&o.shadow);
+    }
+}
+
+/// Marching parameters for one render, derived from the scene's scale.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct March {
+    pub camera: TraceParams,
+    pub secondary: TraceParams,
+}
+
+impl March {
+    pub fn new(scene: &Scene, settings: &RenderSettings) -> March {
+        let scale = scene.scale();
+        let eps_abs = settings.epsilon_abs * scale;
+        let far = 100.0 * scale;
+        let camera = TraceParams {
+            t_min: 0.0,
+            t_max: far,
+            max_steps: settings.max_steps,
+            eps_abs,
+            eps_rel: settings.pixel_epsilon * scene.camera.pixel_angle(settings.height),
+        };
+        let secondary = TraceParams {
+            eps_rel: settings.epsilon_rel,
+            ..camera
+        };
+        March { camera, secondary }
+    }
+}
+
+/// State carried from one vertex to the next for weighting emission.
+#[derive(Clone, Copy)]
+struct Previous {
+    /// Point and facing normal of the last scattering vertex.
+    p: Vec3,
+    n: Vec3,
+    /// pdf with which the BSDF chose the current direction (MIS only).
+    bsdf_pdf: f32,
+    /// Whether emission found along this ray counts in full: camera rays,
+    /// delta bounces, and every strategy but `mis` (where next-event
+    /// estimation has already counted part of it).
+    full_weight: bool,
+}
+
+/// What one path estimate needs besides its random numbers.
+pub(crate) struct Estimator<'a> {
+    pub scene: &'a Scene,
+    pub settings: &'a RenderSettings,
+    pub march: March,
+}
+
+/// Which sample of which pixel a path belongs to.
+#[derive(Clone, Copy)]
+pub(crate) struct SampleId {
+    pub pixel: [u32; 2],
+    pub index: u32,
+}
+
+/// Radiance arriving along `ray`, estimated by one path.
+pub(crate) fn radiance(
+    estimator: &Estimator<'_>,
+    mut ray: Ray,
+    sampler: &mut Sampler,
+    id: SampleId,
+    counters: &mut RayCounters,
+) -> Vec3 {
+    let Estimator {
+        scene,
+        settings,
+        march,
+    } = *estimator;
+    let strategy = settings.strategy;
+    let mut radiance = Vec3::ZERO;
+    let mut beta = Vec3::ONE;
+    let mut previous = Previous {
+        p: ray.origin,
+        n: Vec3::ZERO,
+        bsdf_pdf: 0.0,
+        full_weight: true,
+    };
+    let mut depth = 0u32;
+    let mut params = march.camera;
+
+    loop {
+        let kind = if depth == 0 {
+            &mut counters.camera
+        } else {
+            &mut counters.bounce
+        };
+        let hit = scene.intersect(&ray, &params, kind);
+        let (t, object, epsilon) = match hit {
+            None => {
+                if let Some(sky) = scene.sky {
+                    let w = if previous.full_weight {
+                        1.0
+                    } else {
+                        power_heuristic(
+                            1.0,
+                            previous.bsdf_pdf,
+                            1.0,
+                            scene.sky_pdf(previous.n, ray.dir),
+                        )
+                    };
+                    radiance += beta * sky * w;
+                }
+                break;
+            }
+            Some(Hit::Light { t, light }) => {
+                let le = scene.emitted(light, &ray, t);
+                if le != Vec3::ZERO {
+                    let w = if previous.full_weight {
+                        1.0
+                    } else {
+                        let light_pdf = scene.light_pdf(light, previous.p, previous.n, ray.dir);
+                        power_heuristic(1.0, previous.bsdf_pdf, 1.0, light_pdf)
+                    };
+                    radiance += beta * le * w;
+                }
+                break;
+            }
+            Some(Hit::Surface { t, object, epsilon }) => (t, object, epsilon),
+        };
+        if depth >= settings.max_depth {
+            break;
+        }
+
+        let p = ray.at(t);
+        let sdf = &scene.objects[object].sdf;
+        let h = epsilon.max(1e-5 * scene.scale());
+        let n_geo = normal(sdf, p, h);
+        let wo = -ray.dir;
+        // Shade on the side the ray came from: surfaces are two-sided.
+        let n = if n_geo.dot(wo) < 0.0 { -n_geo } else { n_geo };
+        let origin = p + n * (2.0 * epsilon);
+        let material = scene.materials[scene.objects[object].material];
+
+        sampler.start_pixel_sample(id.pixel, id.index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
+        let u_emitter_choice = sampler.next_1d();
+        let u_emitter = sampler.next_2d();
+        let u_mixture = sampler.next_1d();
+        let u_bsdf = sampler.next_2d();
+        let u_roulette = sampler.next_1d();
+
+        let secondary = TraceParams {
+            eps_abs: march.secondary.eps_abs.max(epsilon),
+            ..march.secondary
+        };
+
+        // Choose the next direction and how emission along it is weighted.
+        let (wi, throughput, bsdf_pdf, full_weight) = match material {
+            Material::Mirror { .. } => {
+                let Some(s) = material.sample(wo, n, u_bsdf, HemisphereSampling::Cosine) else {
+                    break;
+                };
+                (s.wi, s.weight(n), 0.0, true)
+            }
+            Material::Lambertian { .. } => {
+                radiance +=
+                    beta * directional_light(scene, &material, origin, wo, n, &secondary, counters);
+                match strategy {
+                    Strategy::Uniform | Strategy::Cosine => {
+                        let hemisphere = if strategy == Strategy::Uniform {
+                            HemisphereSampling::Uniform
+                        } else {
+                            HemisphereSampling::Cosine
+                        };
+                        let Some(s) = material.sample(wo, n, u_bsdf, hemisphere) else {
+                            break;
+                        };
+                        (s.wi, s.weight(n), s.pdf, true)
+                    }
+                    Strategy::Light => {
+                        let Some((es, _)) =
+                            scene.sample_emitter(origin, n, u_emitter_choice, u_emitter)
+                        else {
+                            break;
+                        };
+                        let pdf = scene.emitter_pdf(origin, n, es.wi);
+                        let f = material.eval(wo, es.wi, n);
+                        if !(pdf > 0.0) || f == Vec3::ZERO {
+                            break;
+                        }
+                        (es.wi, f * n.dot(es.wi).abs() / pdf, pdf, true)
+                    }
+                    Strategy::Mixture => {
+                        let use_light = scene.has_emitters() && u_mixture >= 0.5;
+                        let wi = if use_light {
+                            match scene.sample_emitter(origin, n, u_emitter_choice, u_emitter) {
+                                Some((es, _)) => es.wi,
+                                None => break,
+                            }
+                        } else {
+                            match material.sample(wo, n, u_bsdf, HemisphereSampling::Uniform) {
+                                Some(s) => s.wi,
+                                None => break,
+                            }
+                        };
+                        let hemisphere_pdf = material.pdf(wo, wi, n, HemisphereSampling::Uniform);
+                        let pdf = if scene.has_emitters() {
+                            0.5 * hemisphere_pdf + 0.5 * scene.emitter_pdf(origin, n, wi)
+                        } else {
+                            hemisphere_pdf
+                        };
+                        let f = material.eval(wo, wi, n);
+                        if !(pdf > 0.0) || f == Vec3::ZERO {
+                            break;
+                        }
+                        (wi, f * n.dot(wi).abs() / pdf, pdf, true)
+                    }
+                    Strategy::Mis => {
+                        radiance += beta
+                            * next_event(
+                                scene,
+                                &material,
+                                origin,
+                                wo,
+                                n,
+                                u_emitter_choice,
+                                u_emitter,
+                                &secondary,
+                                counters,
+                            );
+                        let Some(s) = material.sample(wo, n, u_bsdf, HemisphereSampling::Cosine)
+                        else {
+                            break;
+                        };
+                        (s.wi, s.weight(n), s.pdf, false)
+                    }
+                }
+            }
+        };
+
+        beta *= throughput;
+        depth += 1;
+        if beta == Vec3::ZERO || !beta.is_finite() {
+            break;
+        }
+        previous = Previous {
+            p: origin,
+            n,
+            bsdf_pdf,
+            full_weight,
+        };
+        ray = Ray::new(origin, wi);
+        params = secondary;
+
+        // Russian roulette (pbrt-v4 style): unbiased, since survivors are
+        // reweighted by 1 / (1 - q).
+        let max_beta = beta.max_element();
+        if depth >= ROULETTE_DEPTH && max_beta < 1.0 {
+            let q = (1.0 - max_beta).max(0.0);
+            if u_roulette < q {
+                break;
+            }
+            beta /= 1.0 - q;
+        }
+    }
+    radiance
+}
+
+/// Light from every directional light, by a shadow ray each.
+fn directional_light(
+    scene: &Scene,
+    material: &Material,
+    origin: Vec3,
+    wo: Vec3,
+    n: Vec3,
+    params: &TraceParams,
+    counters: &mut RayCounters,
+) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    for light in &scene.lights {
+        if let Light::Directional {
+            direction,
+            irradiance,
+        } = *light
+        {
+            let wi = -direction;
+            let cos = n.dot(wi);
+            if cos <= 0.0 {
+                continue;
+            }
+            let f = material.eval(wo, wi, n);
+            if f == Vec3::ZERO {
+                continue;
+            }
+            if scene.unoccluded(
+                &Ray::new(origin, wi),
+                f32::INFINITY,
+                None,
+                params,
+                &mut counters.shadow,
+            ) {
+                sum += f * irradiance * cos;
+            }
+        }
+    }
+    sum
+}
+
+/// Next-event estimation toward one chosen emitter, MIS-weighted against
+/// cosine BSDF sampling.
+#[allow(clippy::too_many_arguments)]
+fn next_event(
+    scene: &Scene,
+    material: &Material,
+    origin: Vec3,
+    wo: Vec3,
+    n: Vec3,
+    u_choice: f32,
+    u: glam::Vec2,
+    params: &TraceParams,
+    counters: &mut RayCounters,
+) -> Vec3 {
+    let Some((es, light)) = scene.sample_emitter(origin, n, u_choice, u) else {
+        return Vec3::ZERO;
+    };
+    let f = material.eval(wo, es.wi, n);
+    let cos = n.dot(es.wi).abs();
+    if f == Vec3::ZERO || cos == 0.0 || es.radiance == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    if !scene.unoccluded(
+        &Ray::new(origin, es.wi),
+        es.distance,
+        light,
+        params,
+        &mut counters.shadow,
+    ) {
+        return Vec3::ZERO;
+    }
+    let bsdf_pdf = material.pdf(wo, es.wi, n, HemisphereSampling::Cosine);
+    let w = power_heuristic(1.0, es.pdf, 1.0, bsdf_pdf);
+    f * es.radiance * cos * w / es.pdf
+}

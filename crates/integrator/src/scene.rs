@@ -1,0 +1,701 @@
+//! The scene as the integrator sees it: SDF objects with materials, lights,
+//! an optional sky, and the queries the estimators need.
+
+use glam::{Vec2, Vec3};
+use lueur_materials::Material;
+use lueur_sampling::{
+    DirectionSample, DiscreteDistribution, Frame, cosine_hemisphere_pdf, quad_area_pdf,
+    quad_solid_angle_pdf, sample_cosine_hemisphere, sample_quad_area, sample_quad_solid_angle,
+    sample_sphere_light, sphere_light_pdf,
+};
+use lueur_sdf_math::{DistanceField, Ray, Sdf, TraceOutcome, TraceParams, sphere_trace};
+
+use crate::{Camera, SceneError};
+
+/// One piece of geometry and what it is made of.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    /// Its shape.
+    pub sdf: Sdf,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+}
+
+/// A light source. Sphere and quad lights are also visible geometry (they
+/// are intersected analytically, which is exact and cheaper than marching a
+/// zero-thickness quad); directional lights are not.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// A sphere emitting `radiance` outward from its surface.
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius (> 0).
+        radius: f32,
+        /// Emitted radiance.
+        radiance: Vec3,
+    },
+    /// A parallelogram `corner + s edge_u + t edge_v`, emitting on the side
+    /// of `edge_u x edge_v`.
+    Quad {
+        /// One corner.
+        corner: Vec3,
+        /// First edge.
+        edge_u: Vec3,
+        /// Second edge.
+        edge_v: Vec3,
+        /// Emitted radiance.
+        radiance: Vec3,
+    },
+    /// A light at infinity: parallel rays travelling along `direction`.
+    Directional {
+        /// Unit direction in which the light travels.
+        direction: Vec3,
+        /// Irradiance received by a surface facing the light.
+        irradiance: Vec3,
+    },
+}
+
+impl Light {
+    /// Whether the light is a delta distribution in direction, reachable only
+    /// by next-event estimation.
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Light::Directional { .. })
+    }
+}
+
+/// How quad lights are sampled toward a shading point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum QuadSampling {
+    /// Uniform on the area, converted to solid angle (pdf d^2 / (cos a * A)),
+    /// as in the student report.
+    Area,
+    /// Uniform in the solid angle the rectangle subtends (Urena et al.
+    /// 2013); falls back to area sampling for non-rectangular parallelograms.
+    #[default]
+    SolidAngle,
+}
+
+/// A complete scene, ready to render.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Geometry.
+    pub objects: Vec<Object>,
+    /// Materials referenced by the objects.
+    pub materials: Vec<Material>,
+    /// Light sources.
+    pub lights: Vec<Light>,
+    /// Constant radiance arriving from every direction a ray escapes to.
+    pub sky: Option<Vec3>,
+    /// The viewpoint.
+    pub camera: Camera,
+    /// How quad lights are sampled.
+    pub quad_sampling: QuadSampling,
+    // Derived at construction.
+    geometry: Geometry,
+    /// Which samplable emitters exist: indices into `lights`, then the sky.
+    emitters: Vec<Emitter>,
+    emitter_choice: Option<DiscreteDistribution>,
+    scale: f32,
+}
+
+/// An emitter that light sampling can choose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Emitter {
+    Light(usize),
+    Sky,
+}
+
+/// The union of the objects, as a field the tracer marches.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Geometry {
+    sdfs: Vec<Sdf>,
+    lipschitz: f32,
+}
+
+impl DistanceField for Geometry {
+    #[inline]
+    fn distance(&self, p: Vec3) -> f32 {
+        let mut d = f32::INFINITY;
+        for sdf in &self.sdfs {
+            d = d.min(sdf.distance(p));
+        }
+        d
+    }
+
+    fn lipschitz(&self) -> f32 {
+        self.lipschitz
+    }
+}
+
+/// What a ray found first.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Hit {
+    /// An object's surface at distance `t`.
+    Surface {
+        /// Ray parameter.
+        t: f32,
+        /// Index into [`Scene::objects`].
+        object: usize,
+        /// The hit epsilon in force at that distance (sets the offset of
+        /// the next ray).
+        epsilon: f32,
+    },
+    /// A light's surface at distance `t`.
+    Light {
+        /// Ray parameter.
+        t: f32,
+        /// Index into [`Scene::lights`].
+        light: usize,
+    },
+}
+
+/// A direction toward an emitter with the radiance it brings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct EmitterSample {
+    pub wi: Vec3,
+    pub distance: f32,
+    pub radiance: Vec3,
+    /// Solid-angle pdf including the probability of choosing this emitter.
+    pub pdf: f32,
+}
+
+/// Counters of one trace, for statistics.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraceCounters {
+    /// Rays traced.
+    pub rays: u64,
+    /// Scene evaluations (sphere-tracing steps).
+    pub steps: u64,
+    /// Rays that hit a surface.
+    pub hits: u64,
+    /// Rays that escaped.
+    pub misses: u64,
+    /// Rays stopped by the step cap (counted as hits).
+    pub gave_up: u64,
+}
+
+impl TraceCounters {
+    fn record(&mut self, outcome: &TraceOutcome) {
+        self.rays += 1;
+        self.steps += outcome.steps() as u64;
+        match outcome {
+            TraceOutcome::Hit { .. } => self.hits += 1,
+            TraceOutcome::Miss { .. } => self.misses += 1,
+            TraceOutcome::GaveUp { .. } => self.gave_up += 1,
+        }
+    }
+
+    /// Adds another set of counters.
+    pub fn merge(&mut self, o: &TraceCounters) {
+        self.rays += o.rays;
+        self.steps += o.steps;
+        self.hits += o.hits;
+        self.misses += o.misses;
+        self.gave_up += o.gave_up;
+    }
+}
+
+impl Scene {
+    /// Assembles and validates a scene.
+    pub fn new(
+        objects: Vec<Object>,
+        materials: Vec<Material>,
+        lights: Vec<Light>,
+        sky: Option<Vec3>,
+        camera: Camera,
+    ) -> Result<Scene, SceneError> {
+        for (i, o) in objects.iter().enumerate() {
+            if o.material >= materials.len() {
+                return Err(SceneError::MissingMaterial {
+                    object: i,
+                    material: o.material,
+                });
+            }
+        }
+        for (i, l) in lights.iter().enumerate() {
+            let ok = match *l {
+                Light::Sphere {
+                    center,
+                    radius,
+                    radiance,
+                } => {
+                    center.is_finite() && radius > 0.0 && radius.is_finite() && valid_rgb(radiance)
+                }
+                Light::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                    radiance,
+                } => {
+                    corner.is_finite() && edge_u.cross(edge_v).length() > 0.0 && valid_rgb(radiance)
+                }
+                Light::Directional {
+                    direction,
+                    irradiance,
+                } => {
+                    direction.is_finite()
+                        && (direction.length() - 1.0).abs() < 1e-3
+                        && valid_rgb(irradiance)
+                }
+            };
+            if !ok {
+                return Err(SceneError::InvalidLight(i));
+            }
+        }
+        if let Some(sky) = sky
+            && !valid_rgb(sky)
+        {
+            return Err(SceneError::InvalidSky);
+        }
+        let lipschitz = objects
+            .iter()
+            .map(|o| o.sdf.lipschitz())
+            .fold(1.0f32, f32::max);
+        let geometry = Geometry {
+            sdfs: objects.iter().map(|o| o.sdf.clone()).collect(),
+            lipschitz,
+        };
+
+        let mut emitters: Vec<Emitter> = lights
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| !l.is_delta())
+            .map(|(i, _)| Emitter::Light(i))
+            .collect();
+        if sky.is_some() {
+            emitters.push(Emitter::Sky);
+        }
+        // Uniform choice: power-proportional choice needs the sky's power,
+        // which depends on the scene's extent; measured first, changed later.
+        let emitter_choice = DiscreteDistribution::uniform(emitters.len());
+
+        let mut scale: f32 = camera.position().length();
+        for o in &objects {
+            if let Some((c, r)) = o.sdf.bounding_sphere() {
+                scale = scale.max(c.length() + r);
+            }
+        }
+        for l in &lights {
+            match *l {
+                Light::Sphere { center, radius, .. } => scale = scale.max(center.length() + radius),
+                Light::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                    ..
+                } => {
+                    scale = scale.max(
+                        (corner + 0.5 * (edge_u + edge_v)).length() + (edge_u + edge_v).length(),
+                    )
+                }
+                Light::Directional { .. } => {}
+            }
+        }
+        let scale = if scale.is_finite() && scale > 0.0 {
+            scale
+        } else {
+            1.0
+        };
+
+        Ok(Scene {
+            objects,
+            materials,
+            lights,
+            sky,
+            camera,
+            quad_sampling: QuadSampling::default(),
+            geometry,
+            emitters,
+            emitter_choice,
+            scale,
+        })
+    }
+
+    /// A length that bounds the scene's extent from the origin: absolute
+    /// epsilons and the far limit are proportional to it, so a scene scaled
+    /// by 1e-3 or 1e3 renders alike.
+    pub fn scale(&self) -> f32 {
+        self.scale
+    }
+
+    /// The union of all objects as a distance field.
+    pub fn distance(&self, p: Vec3) -> f32 {
+        self.geometry.distance(p)
+    }
+
+    /// The object closest to `p` (after a hit, the one that was hit).
+    pub fn closest_object(&self, p: Vec3) -> usize {
+        let mut best = (f32::INFINITY, 0);
+        for (i, sdf) in self.geometry.sdfs.iter().enumerate() {
+            let d = sdf.distance(p);
+            if d < best.0 {
+                best = (d, i);
+            }
+        }
+        best.1
+    }
+
+    /// Finds the first object or light along `ray`.
+    pub fn intersect(
+        &self,
+        ray: &Ray,
+        params: &TraceParams,
+        counters: &mut TraceCounters,
+    ) -> Option<Hit> {
+        let light_hit = self.intersect_lights(ray, params.t_max, None);
+        let t_max = light_hit.map_or(params.t_max, |(t, _)| t);
+        let mut surface = None;
+        if !self.objects.is_empty() {
+            let p = TraceParams { t_max, ..*params };
+            let outcome = sphere_trace(&self.geometry, ray, &p);
+            counters.record(&outcome);
+            if let Some(t) = outcome.hit_t() {
+                let object = self.closest_object(ray.at(t));
+                let epsilon = params.eps_abs.max(params.eps_rel * t);
+                surface = Some(Hit::Surface { t, object, epsilon });
+            }
+        } else {
+            counters.rays += 1;
+        }
+        surface.or(light_hit.map(|(t, light)| Hit::Light { t, light }))
+    }
+
+    /// Whether the segment from `ray.origin` along `ray.dir` is free of
+    /// objects and of lights other than `target` up to `distance`.
+    pub(crate) fn unoccluded(
+        &self,
+        ray: &Ray,
+        distance: f32,
+        target: Option<usize>,
+        params: &TraceParams,
+        counters: &mut TraceCounters,
+    ) -> bool {
+        // Stop short of the light's surface so that its own geometry (for
+        // lights that are objects too) does not occlude it.
+        let t_max = (distance * (1.0 - 1e-4) - params.eps_abs).min(params.t_max);
+        if let Some((_, l)) = self.intersect_lights(ray, t_max, target)
+            && Some(l) != target
+        {
+            return false;
+        }
+        if self.objects.is_empty() || t_max <= params.t_min {
+            return true;
+        }
+        let outcome = sphere_trace(&self.geometry, ray, &TraceParams { t_max, ..*params });
+        counters.record(&outcome);
+        outcome.hit_t().is_none()
+    }
+
+    fn intersect_lights(&self, ray: &Ray, t_max: f32, skip: Option<usize>) -> Option<(f32, usize)> {
+        let mut best: Option<(f32, usize)> = None;
+        for (i, l) in self.lights.iter().enumerate() {
+            if Some(i) == skip {
+                continue;
+            }
+            let t = match *l {
+                Light::Sphere { center, radius, .. } => ray_sphere(ray, center, radius),
+                Light::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                    ..
+                } => ray_quad(ray, corner, edge_u, edge_v),
+                Light::Directional { .. } => None,
+            };
+            if let Some(t) = t
+                && t < t_max
+                && best.is_none_or(|(bt, _)| t < bt)
+            {
+                best = Some((t, i));
+            }
+        }
+        best
+    }
+
+    /// Radiance emitted by light `i` toward `-dir` from the point its ray hit.
+    pub fn emitted(&self, light: usize, ray: &Ray, t: f32) -> Vec3 {
+        match self.lights[light] {
+            Light::Sphere {
+                center, radiance, ..
+            } => {
+                // Emits outward only: a ray from inside sees the back face.
+                if (ray.at(t) - center).dot(ray.dir) < 0.0 {
+                    radiance
+                } else {
+                    Vec3::ZERO
+                }
+            }
+            Light::Quad {
+                edge_u,
+                edge_v,
+                radiance,
+                ..
+            } => {
+                if edge_u.cross(edge_v).dot(ray.dir) < 0.0 {
+                    radiance
+                } else {
+                    Vec3::ZERO
+                }
+            }
+            Light::Directional { .. } => Vec3::ZERO,
+        }
+    }
+
+    /// Whether light sampling has anything to sample.
+    pub(crate) fn has_emitters(&self) -> bool {
+        self.emitter_choice.is_some()
+    }
+
+    /// Chooses an emitter and a direction toward it from `p` (normal `n`,
+    /// used only by the sky's cosine sampling).
+    pub(crate) fn sample_emitter(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        u_choice: f32,
+        u: Vec2,
+    ) -> Option<(EmitterSample, Option<usize>)> {
+        let choice = self.emitter_choice.as_ref()?;
+        let (k, pmf) = choice.sample(u_choice);
+        match self.emitters[k] {
+            Emitter::Sky => {
+                let sky = self.sky?;
+                let local = sample_cosine_hemisphere(u);
+                let pdf = cosine_hemisphere_pdf(local.z);
+                if !(pdf > 0.0) {
+                    return None;
+                }
+                let wi = Frame::from_normal(n).to_world(local).normalize();
+                Some((
+                    EmitterSample {
+                        wi,
+                        distance: f32::INFINITY,
+                        radiance: sky,
+                        pdf: pdf * pmf,
+                    },
+                    None,
+                ))
+            }
+            Emitter::Light(i) => {
+                let (s, radiance) = self.sample_light(i, p, u)?;
+                if !(s.pdf > 0.0) || !s.pdf.is_finite() {
+                    return None;
+                }
+                Some((
+                    EmitterSample {
+                        wi: s.wi,
+                        distance: s.distance,
+                        radiance,
+                        pdf: s.pdf * pmf,
+                    },
+                    Some(i),
+                ))
+            }
+        }
+    }
+
+    fn sample_light(&self, i: usize, p: Vec3, u: Vec2) -> Option<(DirectionSample, Vec3)> {
+        match self.lights[i] {
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                let s = sample_sphere_light(p, center, radius, u)?;
+                // Only the outward face emits.
+                if s.normal.dot(s.wi) >= 0.0 {
+                    return None;
+                }
+                Some((s, radiance))
+            }
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => {
+                let s = match self.quad_sampling {
+                    QuadSampling::SolidAngle if is_rectangle(edge_u, edge_v) => {
+                        // Falls back to area sampling where the solid angle is
+                        // too small for the spherical-rectangle warp's f32 math.
+                        sample_quad_solid_angle(p, corner, edge_u, edge_v, u)?
+                    }
+                    _ => sample_quad_area(p, corner, edge_u, edge_v, u)?,
+                };
+                Some((s, radiance))
+            }
+            Light::Directional { .. } => None,
+        }
+    }
+
+    /// Solid-angle pdf with which [`Scene::sample_emitter`] picks `wi` from
+    /// `p`, summed over every emitter that direction could come from.
+    pub(crate) fn emitter_pdf(&self, p: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        let Some(choice) = self.emitter_choice.as_ref() else {
+            return 0.0;
+        };
+        let mut pdf = 0.0;
+        for (k, e) in self.emitters.iter().enumerate() {
+            pdf += choice.pmf(k) * self.single_emitter_pdf(*e, p, n, wi);
+        }
+        pdf
+    }
+
+    /// The same for emitter light `i` only (the light a BSDF ray hit).
+    pub(crate) fn light_pdf(&self, light: usize, p: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        let Some(choice) = self.emitter_choice.as_ref() else {
+            return 0.0;
+        };
+        match self
+            .emitters
+            .iter()
+            .position(|e| *e == Emitter::Light(light))
+        {
+            Some(k) => choice.pmf(k) * self.single_emitter_pdf(Emitter::Light(light), p, n, wi),
+            None => 0.0,
+        }
+    }
+
+    /// The same for the sky only.
+    pub(crate) fn sky_pdf(&self, n: Vec3, wi: Vec3) -> f32 {
+        let Some(choice) = self.emitter_choice.as_ref() else {
+            return 0.0;
+        };
+        match self.emitters.iter().position(|e| *e == Emitter::Sky) {
+            Some(k) => choice.pmf(k) * self.single_emitter_pdf(Emitter::Sky, Vec3::ZERO, n, wi),
+            None => 0.0,
+        }
+    }
+
+    fn single_emitter_pdf(&self, e: Emitter, p: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        match e {
+            Emitter::Sky => cosine_hemisphere_pdf(n.dot(wi)),
+            Emitter::Light(i) => match self.lights[i] {
+                Light::Sphere { center, radius, .. } => {
+                    // Directions that reach the sphere from inside hit its
+                    // back face: the sampler rejects those, so they have
+                    // zero density.
+                    if (p - center).length_squared() <= radius * radius {
+                        let Some(t) = ray_sphere(&Ray::new(p, wi), center, radius) else {
+                            return 0.0;
+                        };
+                        if (p + wi * t - center).dot(wi) >= 0.0 {
+                            return 0.0;
+                        }
+                    }
+                    sphere_light_pdf(p, center, radius, wi)
+                }
+                Light::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                    ..
+                } => match self.quad_sampling {
+                    QuadSampling::SolidAngle if is_rectangle(edge_u, edge_v) => {
+                        quad_solid_angle_pdf(p, corner, edge_u, edge_v, wi)
+                    }
+                    _ => quad_area_pdf(p, corner, edge_u, edge_v, wi),
+                },
+                Light::Directional { .. } => 0.0,
+            },
+        }
+    }
+}
+
+fn valid_rgb(c: Vec3) -> bool {
+    c.is_finite() && c.min_element() >= 0.0
+}
+
+fn is_rectangle(edge_u: Vec3, edge_v: Vec3) -> bool {
+    edge_u.dot(edge_v).abs() <= 1e-4 * edge_u.length() * edge_v.length()
+}
+
+/// Nearest positive intersection of a ray with a sphere (from outside or
+/// inside). Uses the numerically stable form of pbrt-v4 (section 6.8.1):
+/// the discriminant from `|o - c - (b) d|` avoids cancellation far away.
+pub(crate) fn ray_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<f32> {
+    let oc = ray.origin - center;
+    let b = oc.dot(ray.dir);
+    let perp = oc - b * ray.dir;
+    let disc = radius * radius - perp.length_squared();
+    if disc < 0.0 {
+        return None;
+    }
+    let root = disc.sqrt();
+    let q = if b > 0.0 { -b - root } else { -b + root };
+    let (mut t0, mut t1) = (
+        q,
+        if q != 0.0 {
+            (oc.length_squared() - radius * radius) / q
+        } else {
+            q
+        },
+    );
+    if t0 > t1 {
+        std::mem::swap(&mut t0, &mut t1);
+    }
+    if t0 > 0.0 {
+        Some(t0)
+    } else if t1 > 0.0 {
+        Some(t1)
+    } else {
+        None
+    }
+}
+
+/// Intersection of a ray with the parallelogram `corner + s eu + t ev`.
+pub(crate) fn ray_quad(ray: &Ray, corner: Vec3, edge_u: Vec3, edge_v: Vec3) -> Option<f32> {
+    let n = edge_u.cross(edge_v);
+    let denom = n.dot(ray.dir);
+    if denom == 0.0 {
+        return None;
+    }
+    let t = n.dot(corner - ray.origin) / denom;
+    if !(t > 0.0) || !t.is_finite() {
+        return None;
+    }
+    let q = ray.at(t) - corner;
+    // Coordinates in the (edge_u, edge_v) basis by Cramer's rule with the
+    // plane normal (works for any parallelogram).
+    let nn = n.length_squared();
+    let s = n.dot(q.cross(edge_v)) / nn;
+    let r = n.dot(edge_u.cross(q)) / nn;
+    if (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r) {
+        Some(t)
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ray_sphere_from_outside_and_inside() {
+        let r = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
+        assert!((ray_sphere(&r, Vec3::ZERO, 1.0).unwrap() - 4.0).abs() < 1e-5);
+        let inside = Ray::new(Vec3::ZERO, Vec3::Z);
+        assert!((ray_sphere(&inside, Vec3::ZERO, 1.0).unwrap() - 1.0).abs() < 1e-5);
+        let away = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::Z);
+        assert!(ray_sphere(&away, Vec3::ZERO, 1.0).is_none());
+        let far = Ray::new(Vec3::new(0.0, 0.0, -1e4), Vec3::Z);
+        assert!((ray_sphere(&far, Vec3::ZERO, 1.0).unwrap() - (1e4 - 1.0)).abs() < 1e-2);
+    }
+
+    #[test]
+    fn ray_quad_hits_inside_only() {
+        let (c, u, v) = (
+            Vec3::new(-1.0, 2.0, -1.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 2.0),
+        );
+        let up = Ray::new(Vec3::ZERO, Vec3::Y);
+        assert!((ray_quad(&up, c, u, v).unwrap() - 2.0).abs() < 1e-6);
+        let off = Ray::new(Vec3::new(1.5, 0.0, 0.0), Vec3::Y);
+        assert!(ray_quad(&off, c, u, v).is_none());
+        let down = Ray::new(Vec3::ZERO, -Vec3::Y);
+        assert!(ray_quad(&down, c, u, v).is_none());
+    }
+}
