@@ -1,1 +1,252 @@
-fn main() {}
+//! `lueur`: the command-line renderer. A thin shell over the library
+//! crates: it reads scene files, draws the progress bar and writes images;
+//! every decision about light lives in `lueur-integrator`.
+
+mod output;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use lueur_integrator::{RenderOutput, RenderSettings, Strategy, render};
+use lueur_sampling::SamplerKind;
+use lueur_scene::{SceneFileError, parse_scene};
+
+/// Exit status for input the user must fix (scene files, flags), as clap
+/// does for usage errors.
+const EXIT_BAD_INPUT: u8 = 2;
+
+#[derive(Parser)]
+#[command(
+    name = "lueur",
+    version,
+    about = "A physically based SDF renderer with measured Monte Carlo"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene file to an image (.png: 8-bit sRGB; .exr: linear float
+    /// RGB plus the per-pixel variance of the mean).
+    Render(RenderArgs),
+}
+
+#[derive(Parser)]
+struct RenderArgs {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// Output image; the extension picks the format. Default: SCENE_NAME.png.
+    #[arg(long, short)]
+    out: Option<PathBuf>,
+    /// Samples per pixel.
+    #[arg(long)]
+    spp: Option<u32>,
+    /// How directions are chosen: uniform, cosine, light, mixture or mis.
+    #[arg(long, value_parser = parse_strategy)]
+    strategy: Option<Strategy>,
+    /// Which point set feeds the estimator.
+    #[arg(long, value_parser = parse_sampler)]
+    sampler: Option<SamplerKind>,
+    /// Seed of all random numbers.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Maximum number of scattering events (0: only emitters seen directly).
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Image width in pixels.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Worker threads (default: one per core). The image does not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Exposure in stops applied before PNG encoding (EXR stays linear).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    exposure: f32,
+    /// Print statistics after the render: rays, steps per ray, hit shares.
+    #[arg(long)]
+    stats: bool,
+}
+
+fn parse_strategy(s: &str) -> Result<Strategy, String> {
+    Strategy::from_name(s).ok_or_else(|| {
+        let all: Vec<_> = Strategy::ALL.iter().map(|s| s.name()).collect();
+        format!("unknown strategy `{s}`; expected one of {}", all.join(", "))
+    })
+}
+
+fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
+    SamplerKind::from_name(s).ok_or_else(|| {
+        let all: Vec<_> = SamplerKind::ALL.iter().map(|s| s.name()).collect();
+        format!("unknown sampler `{s}`; expected one of {}", all.join(", "))
+    })
+}
+
+/// An error the user caused and can fix; exits with status 2.
+#[derive(Debug)]
+struct BadInput(String);
+
+impl std::fmt::Display for BadInput {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for BadInput {}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => run_render(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            if let Some(scene_error) = e.downcast_ref::<SceneFileError>() {
+                eprint!("{scene_error}");
+                if !scene_error.to_string().ends_with('\n') {
+                    eprintln!();
+                }
+                return ExitCode::from(EXIT_BAD_INPUT);
+            }
+            eprintln!("error: {e:#}");
+            if e.downcast_ref::<BadInput>().is_some() {
+                ExitCode::from(EXIT_BAD_INPUT)
+            } else {
+                ExitCode::FAILURE
+            }
+        }
+    }
+}
+
+fn run_render(args: RenderArgs) -> Result<()> {
+    let file = args.scene.display().to_string();
+    let text = std::fs::read_to_string(&args.scene)
+        .map_err(|e| BadInput(format!("cannot read scene file {file}: {e}")))?;
+    let parsed = parse_scene(&text, &file)?;
+    let scene = parsed.scene;
+    let settings = apply_flags(parsed.settings, &args)?;
+    let out = match &args.out {
+        Some(p) => p.clone(),
+        None => default_output(&args.scene),
+    };
+    let format = output::Format::from_path(&out).map_err(|e| BadInput(e.to_string()))?;
+
+    let pixels = settings.width as u64 * settings.height as u64;
+    let bar = ProgressBar::new(pixels);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {wide_bar} {percent}% ETA {eta}",
+        )
+        .expect("the template is valid"),
+    );
+    let progress = |n: u64| bar.inc(n);
+    let output: RenderOutput = match args.threads {
+        Some(0) => return Err(BadInput("--threads must be at least 1".into()).into()),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .context("cannot start the worker threads")?
+            .install(|| render(&scene, &settings, &progress)),
+        None => render(&scene, &settings, &progress),
+    }
+    .map_err(|e| BadInput(e.to_string()))?;
+    bar.finish_and_clear();
+
+    output::write_image(&out, format, &output.film, args.exposure)
+        .with_context(|| format!("cannot write {}", out.display()))?;
+
+    let stats = &output.stats;
+    let secs = stats.elapsed.as_secs_f64();
+    eprintln!(
+        "rendered {}x{} at {} spp ({}, {}) in {:.2} s, {:.2} M samples/s -> {}",
+        settings.width,
+        settings.height,
+        settings.spp,
+        settings.strategy,
+        settings.sampler.name(),
+        secs,
+        stats.samples as f64 / secs.max(1e-9) / 1e6,
+        out.display()
+    );
+    if stats.dropped_samples > 0 {
+        eprintln!(
+            "warning: {} NaN or infinite samples were dropped",
+            stats.dropped_samples
+        );
+    }
+    if args.stats {
+        print_stats(&output);
+    }
+    Ok(())
+}
+
+fn apply_flags(mut s: RenderSettings, a: &RenderArgs) -> Result<RenderSettings> {
+    if let Some(v) = a.spp {
+        s.spp = v;
+    }
+    if let Some(v) = a.strategy {
+        s.strategy = v;
+    }
+    if let Some(v) = a.sampler {
+        s.sampler = v;
+    }
+    if let Some(v) = a.seed {
+        s.seed = v;
+    }
+    if let Some(v) = a.max_depth {
+        s.max_depth = v;
+    }
+    if let Some(v) = a.width {
+        s.width = v;
+    }
+    if let Some(v) = a.height {
+        s.height = v;
+    }
+    if !a.exposure.is_finite() {
+        bail!(BadInput("--exposure must be finite".into()));
+    }
+    s.validate().map_err(|e| BadInput(e.to_string()))?;
+    Ok(s)
+}
+
+fn default_output(scene: &Path) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
+    PathBuf::from(format!("{stem}.png"))
+}
+
+fn print_stats(out: &RenderOutput) {
+    let s = &out.stats;
+    let secs = s.elapsed.as_secs_f64().max(1e-9);
+    println!(
+        "samples          {:>14}  ({:.3} M/s)",
+        s.samples,
+        s.samples as f64 / secs / 1e6
+    );
+    println!("dropped (NaN/Inf){:>14}", s.dropped_samples);
+    for (name, c) in [
+        ("camera", &s.rays.camera),
+        ("bounce", &s.rays.bounce),
+        ("shadow", &s.rays.shadow),
+    ] {
+        let rays = c.rays.max(1) as f64;
+        println!(
+            "{name:<7} rays {:>12}  ({:.3} M/s)  steps/ray {:>6.1}  hit {:>5.1}%  miss {:>5.1}%  gave up {:>5.2}%",
+            c.rays,
+            c.rays as f64 / secs / 1e6,
+            c.steps as f64 / rays,
+            100.0 * c.hits as f64 / rays,
+            100.0 * c.misses as f64 / rays,
+            100.0 * c.gave_up as f64 / rays,
+        );
+    }
+}

@@ -1,0 +1,93 @@
+//! Writing images: atomically, so an interrupted write never leaves a
+//! truncated file behind.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use glam::Vec3;
+use lueur_integrator::Film;
+
+/// Image formats, chosen by the output's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// 8-bit sRGB, clamped.
+    Png,
+    /// Linear 32-bit float RGB plus the variance of each pixel's mean.
+    Exr,
+}
+
+impl Format {
+    pub fn from_path(path: &Path) -> Result<Format> {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("png") => Ok(Format::Png),
+            Some("exr") => Ok(Format::Exr),
+            _ => bail!(
+                "cannot tell the image format of {}: use a .png or .exr extension",
+                path.display()
+            ),
+        }
+    }
+}
+
+/// Writes the film's mean (and for EXR its variance) to `path`.
+pub fn write_image(path: &Path, format: Format, film: &Film, exposure: f32) -> Result<()> {
+    let tmp = temporary_path(path);
+    let result = match format {
+        Format::Png => write_png(&tmp, film, exposure),
+        Format::Exr => write_exr(&tmp, film),
+    };
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    std::fs::rename(&tmp, path).with_context(|| format!("cannot move {} into place", tmp.display()))
+}
+
+fn temporary_path(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map_or_else(|| "image".into(), |n| n.to_string_lossy().into_owned());
+    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+}
+
+fn write_png(path: &Path, film: &Film, exposure: f32) -> Result<()> {
+    let bytes = film.srgb8(exposure);
+    let img = image::RgbImage::from_raw(film.width(), film.height(), bytes)
+        .context("film size mismatch")?;
+    img.save_with_format(path, image::ImageFormat::Png)?;
+    Ok(())
+}
+
+fn write_exr(path: &Path, film: &Film) -> Result<()> {
+    use exr::prelude::*;
+    let channel = |name: &str, f: &dyn Fn(Vec3) -> f32, image: &[Vec3]| {
+        AnyChannel::new(
+            name,
+            FlatSamples::F32(image.iter().map(|&v| f(v)).collect()),
+        )
+    };
+    let mean = film.mean_image();
+    let var = film.variance_image();
+    let channels = AnyChannels::sort(SmallVec::from_vec(vec![
+        channel("R", &|v| v.x, &mean),
+        channel("G", &|v| v.y, &mean),
+        channel("B", &|v| v.z, &mean),
+        channel("variance.R", &|v| v.x, &var),
+        channel("variance.G", &|v| v.y, &var),
+        channel("variance.B", &|v| v.z, &var),
+    ]));
+    let size = (film.width() as usize, film.height() as usize);
+    let layer = Layer::new(
+        size,
+        LayerAttributes::named("lueur"),
+        Encoding::SMALL_LOSSLESS,
+        channels,
+    );
+    Image::from_layer(layer).write().to_file(path)?;
+    Ok(())
+}
