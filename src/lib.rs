@@ -1,1 +1,32 @@
-//! placeholder
+//! lueur: a physically based renderer whose geometry is signed distance
+//! functions, rendered by sphere tracing, built to *measure* Monte Carlo.
+//!
+//! This facade only re-exports the workspace's library crates, bottom to
+//! top, so that one dependency gives the whole pipeline, and so that the
+//! end-to-end tests in `tests/` can drive it. It adds nothing of its own.
+//!
+//! ```
+//! let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell-spheres.toml")).unwrap();
+//! let mut file = lueur::scene::parse_scene(&text, "cornell-spheres.toml").unwrap();
+//! file.settings.width = 16;
+//! file.settings.height = 16;
+//! file.settings.spp = 4;
+//! let out = lueur::integrator::render(&file.scene, &file.settings, &|_| {}).unwrap();
+//! assert_eq!(out.stats.dropped_samples, 0);
+//! ```
+#![deny(missing_docs)]
+
+/// Signed distance functions and the sphere tracer.
+pub use lueur_sdf_math as sdf_math;
+
+/// Warps, pdfs, MIS weights and point sets.
+pub use lueur_sampling as sampling;
+
+/// BSDFs: Lambertian and mirror.
+pub use lueur_materials as materials;
+
+/// Scenes, strategies, the film and the render loop.
+pub use lueur_integrator as integrator;
+
+/// Scene files.
+pub use lueur_scene as scene;

@@ -1,0 +1,18 @@
+//! End-to-end tests of the whole pipeline: scene files in, films out.
+//!
+//! Statistical tests state their confidence next to their threshold and use
+//! fixed seeds, so they are reproducible; each would fail on a real bias of
+//! a few percent (see `analytic::a_wrong_pdf_is_caught`).
+
+mod common;
+
+// Same scene, seed and spp give the same film bit for bit, whatever the
+// thread count.
+mod determinism;
+
+// Closed-form radiance: furnaces, a sphere light and a quad light over a plane.
+mod analytic;
+
+// The strategies against each other on the shipped scenes, and the report's
+// variance claim.
+mod strategies;
