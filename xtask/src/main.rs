@@ -1,1 +1,85 @@
-fn main() {}
+//! `cargo xtask`: lueur's lab bench. Each subcommand regenerates something
+//! under `docs/` from the scene files, deterministically (fixed seeds).
+
+mod figures;
+mod variance;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use lueur::integrator::{Film, RenderSettings, Scene, render};
+use lueur::scene::{SceneFile, parse_scene};
+
+#[derive(Parser)]
+#[command(name = "xtask", about = "Regenerate lueur's figures and measurements")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render the shipped scenes and the strategy comparisons to docs/figures/.
+    Figures {
+        /// Smaller images and fewer samples, for CI.
+        #[arg(long)]
+        quick: bool,
+    },
+    /// Measure each strategy's per-pixel variance on the shipped scenes and
+    /// check the report's claims; writes docs/VARIANCE.md.
+    Variance {
+        /// Smaller images and fewer samples, for CI.
+        #[arg(long)]
+        quick: bool,
+    },
+}
+
+fn main() -> Result<()> {
+    match Cli::parse().command {
+        Command::Figures { quick } => figures::run(quick),
+        Command::Variance { quick } => variance::run(quick),
+    }
+}
+
+/// The workspace root (the parent of this crate's manifest directory).
+pub fn project_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives in the workspace")
+        .to_path_buf()
+}
+
+/// Loads `scenes/NAME.toml`.
+pub fn load_scene(name: &str) -> Result<SceneFile> {
+    let path = project_root().join("scenes").join(format!("{name}.toml"));
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    Ok(parse_scene(&text, &format!("scenes/{name}.toml"))?)
+}
+
+/// Renders with a progress bar labelled `label`.
+pub fn render_with_bar(scene: &Scene, settings: &RenderSettings, label: &str) -> Result<Film> {
+    let bar = indicatif::ProgressBar::new(settings.width as u64 * settings.height as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg:>32} {wide_bar} {percent:>3}% ETA {eta}")
+            .expect("valid template"),
+    );
+    bar.set_message(label.to_owned());
+    let out = render(scene, settings, &|n| bar.inc(n))?;
+    bar.finish_and_clear();
+    anyhow::ensure!(
+        out.stats.dropped_samples == 0,
+        "{label}: {} NaN/Inf samples",
+        out.stats.dropped_samples
+    );
+    Ok(out.film)
+}
+
+/// Writes a film as an sRGB PNG.
+pub fn save_png(film: &Film, path: &Path) -> Result<()> {
+    let img = image::RgbImage::from_raw(film.width(), film.height(), film.srgb8(0.0))
+        .context("film size")?;
+    img.save(path)
+        .with_context(|| format!("writing {}", path.display()))
+}
