@@ -3,7 +3,7 @@
 use glam::Vec3;
 use lueur_materials::{HemisphereSampling, Material};
 use lueur_sampling::{Sampler, power_heuristic};
-use lueur_sdf_math::{Ray, TraceParams, normal};
+use lueur_sdf_math::{FALLBACK_NORMAL, Ray, Sdf, TraceParams, gradient};
 
 use crate::scene::{Hit, Light, Scene, TraceCounters};
 use crate::{RenderSettings, Strategy};
@@ -45,6 +45,8 @@ impl RayCounters {
 pub(crate) struct March {
     pub camera: TraceParams,
     pub secondary: TraceParams,
+    /// Smallest offset of a ray's origin above the surface it leaves.
+    pub spawn_floor: f32,
 }
 
 impl March {
@@ -63,7 +65,77 @@ impl March {
             eps_rel: settings.epsilon_rel,
             ..camera
         };
-        March { camera, secondary }
+        // Rays leave surfaces at least this far above them: far above the
+        // secondary hit threshold at their start (eps_abs), and above the
+        // f32 rounding of positions in a scene of this size.
+        let spawn_floor = (64.0 * eps_abs).max(16.0 * f32::EPSILON * scale);
+        March {
+            camera,
+            secondary,
+            spawn_floor,
+        }
+    }
+}
+
+/// A hit made usable for shading: the tracer stops anywhere in a shell of
+/// width `epsilon` around the surface (a quarter pixel for camera rays), so
+/// shading there would measure light from the wrong point. One Newton step
+/// along the gradient moves the point onto the surface; rays leave from just
+/// above it, by an offset that covers what the projection left over.
+/// Sampling, pdfs and MIS weights use `p`; only ray origins use `origin`
+/// (pbrt-v4's split between the interaction point and `SpawnRay`).
+pub(crate) struct SurfacePoint {
+    /// The point on the surface.
+    pub p: Vec3,
+    /// Unit normal, facing the side the ray came from (surfaces are two-sided).
+    pub n: Vec3,
+    /// Where rays leaving the surface start.
+    pub origin: Vec3,
+}
+
+impl SurfacePoint {
+    /// 6 field evaluations: the tetrahedron gradient, the distance at the hit
+    /// and the distance after the projection.
+    fn new(sdf: &Sdf, hit: Vec3, wo: Vec3, epsilon: f32, spawn_floor: f32) -> SurfacePoint {
+        let grad = gradient(sdf, hit, epsilon.max(spawn_floor));
+        let g = grad.length();
+        let n_geo = if g.is_finite() && g > 0.0 {
+            grad / g
+        } else {
+            FALLBACK_NORMAL
+        };
+        // f / |grad f| is the distance to first order, also for bounds (L > 1).
+        let step = sdf.distance(hit) / g;
+        let p = if step.is_finite() && step.abs() <= 4.0 * epsilon.max(spawn_floor) {
+            hit - n_geo * step
+        } else {
+            hit
+        };
+        let residual = (sdf.distance(p) / g.max(1e-3)).abs();
+        let n = if n_geo.dot(wo) < 0.0 { -n_geo } else { n_geo };
+        let offset = spawn_floor.max(if residual.is_finite() {
+            4.0 * residual
+        } else {
+            epsilon
+        });
+        SurfacePoint {
+            p,
+            n,
+            origin: p + n * offset,
+        }
+    }
+
+    /// A ray from the surface toward what lies at `distance` along `wi` from
+    /// `p`, and the distance to it from the ray's origin.
+    fn shadow_ray(&self, wi: Vec3, distance: f32) -> (Ray, f32) {
+        if distance.is_finite() {
+            let to = self.p + wi * distance - self.origin;
+            let d = to.length();
+            if d > 0.0 && d.is_finite() {
+                return (Ray::new(self.origin, to / d), d);
+            }
+        }
+        (Ray::new(self.origin, wi), distance)
     }
 }
 
@@ -163,14 +235,10 @@ pub(crate) fn radiance(
             break;
         }
 
-        let p = ray.at(t);
-        let sdf = &scene.objects[object].sdf;
-        let h = epsilon.max(1e-5 * scene.scale());
-        let n_geo = normal(sdf, p, h);
         let wo = -ray.dir;
-        // Shade on the side the ray came from: surfaces are two-sided.
-        let n = if n_geo.dot(wo) < 0.0 { -n_geo } else { n_geo };
-        let origin = p + n * (2.0 * epsilon);
+        let sdf = &scene.objects[object].sdf;
+        let surface = SurfacePoint::new(sdf, ray.at(t), wo, epsilon, march.spawn_floor);
+        let (p, n, origin) = (surface.p, surface.n, surface.origin);
         let material = scene.materials[scene.objects[object].material];
 
         sampler.start_pixel_sample(id.pixel, id.index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
@@ -180,10 +248,7 @@ pub(crate) fn radiance(
         let u_bsdf = sampler.next_2d();
         let u_roulette = sampler.next_1d();
 
-        let secondary = TraceParams {
-            eps_abs: march.secondary.eps_abs.max(epsilon),
-            ..march.secondary
-        };
+        let secondary = march.secondary;
 
         // Choose the next direction and how emission along it is weighted.
         let (wi, throughput, bsdf_pdf, full_weight) = match material {
@@ -209,12 +274,11 @@ pub(crate) fn radiance(
                         (s.wi, s.weight(n), s.pdf, true)
                     }
                     Strategy::Light => {
-                        let Some((es, _)) =
-                            scene.sample_emitter(origin, n, u_emitter_choice, u_emitter)
+                        let Some((es, _)) = scene.sample_emitter(p, n, u_emitter_choice, u_emitter)
                         else {
                             break;
                         };
-                        let pdf = scene.emitter_pdf(origin, n, es.wi);
+                        let pdf = scene.emitter_pdf(p, n, es.wi);
                         let f = material.eval(wo, es.wi, n);
                         if !(pdf > 0.0) || f == Vec3::ZERO {
                             break;
@@ -224,7 +288,7 @@ pub(crate) fn radiance(
                     Strategy::Mixture => {
                         let use_light = scene.has_emitters() && u_mixture >= 0.5;
                         let wi = if use_light {
-                            match scene.sample_emitter(origin, n, u_emitter_choice, u_emitter) {
+                            match scene.sample_emitter(p, n, u_emitter_choice, u_emitter) {
                                 Some((es, _)) => es.wi,
                                 None => break,
                             }
@@ -236,7 +300,7 @@ pub(crate) fn radiance(
                         };
                         let hemisphere_pdf = material.pdf(wo, wi, n, HemisphereSampling::Uniform);
                         let pdf = if scene.has_emitters() {
-                            0.5 * hemisphere_pdf + 0.5 * scene.emitter_pdf(origin, n, wi)
+                            0.5 * hemisphere_pdf + 0.5 * scene.emitter_pdf(p, n, wi)
                         } else {
                             hemisphere_pdf
                         };
@@ -251,7 +315,7 @@ pub(crate) fn radiance(
                             * next_event(
                                 scene,
                                 &material,
-                                origin,
+                                &surface,
                                 wo,
                                 n,
                                 u_emitter_choice,
@@ -275,7 +339,7 @@ pub(crate) fn radiance(
             break;
         }
         previous = Previous {
-            p: origin,
+            p,
             n,
             bsdf_pdf,
             full_weight,
@@ -343,7 +407,7 @@ fn directional_light(
 fn next_event(
     scene: &Scene,
     material: &Material,
-    origin: Vec3,
+    surface: &SurfacePoint,
     wo: Vec3,
     n: Vec3,
     u_choice: f32,
@@ -351,7 +415,7 @@ fn next_event(
     params: &TraceParams,
     counters: &mut RayCounters,
 ) -> Vec3 {
-    let Some((es, light)) = scene.sample_emitter(origin, n, u_choice, u) else {
+    let Some((es, light)) = scene.sample_emitter(surface.p, n, u_choice, u) else {
         return Vec3::ZERO;
     };
     let f = material.eval(wo, es.wi, n);
@@ -359,13 +423,8 @@ fn next_event(
     if f == Vec3::ZERO || cos == 0.0 || es.radiance == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    if !scene.unoccluded(
-        &Ray::new(origin, es.wi),
-        es.distance,
-        light,
-        params,
-        &mut counters.shadow,
-    ) {
+    let (shadow_ray, distance) = surface.shadow_ray(es.wi, es.distance);
+    if !scene.unoccluded(&shadow_ray, distance, light, params, &mut counters.shadow) {
         return Vec3::ZERO;
     }
     let bsdf_pdf = material.pdf(wo, es.wi, n, HemisphereSampling::Cosine);

@@ -17,6 +17,15 @@ pub const FALLBACK_NORMAL: Vec3 = Vec3::Y;
 /// `h` is made non-negative and raised to a few ulps of `p`'s largest coordinate, because
 /// below that `p + h` rounds back to `p` and every sample would be the same number.
 pub fn normal<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
+    unit_or_fallback(gradient(field, p, h))
+}
+
+/// The gradient of the field at `p` by the same tetrahedron (4 evaluations), not
+/// normalised: its length is the local Lipschitz ratio, 1 for exact distances, which lets
+/// a caller move a point onto the surface (`p - grad f(p) / |grad|^2`).
+///
+/// Unlike [`normal`] this may be zero or non-finite; callers must check.
+pub fn gradient<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
     // iq, "normalsSDF": the vertices of a tetrahedron sum to zero, so sum_i k_i f(p + h k_i)
     // is proportional to the gradient, with one evaluation fewer than central differences.
     const K: [Vec3; 4] = [
@@ -26,10 +35,10 @@ pub fn normal<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
         Vec3::new(1.0, 1.0, 1.0),
     ];
     let h = usable_step(p, h);
-    let gradient = K
-        .iter()
-        .fold(Vec3::ZERO, |acc, &k| acc + k * field.distance(p + k * h));
-    unit_or_fallback(gradient)
+    // sum_i k_i (k_i . grad) h = 4 h grad, since sum_i k_i k_i^T = 4 I.
+    K.iter()
+        .fold(Vec3::ZERO, |acc, &k| acc + k * field.distance(p + k * h))
+        / (4.0 * h)
 }
 
 /// Central differences (6 evaluations), kept as the naive reference for [`normal`].
