@@ -32,7 +32,8 @@
 //! assert_eq!(file.scene.objects.len(), 1);
 //!
 //! let err = lueur_scene::parse_scene(&text.replace("0.2, rotate", "-0.2, rotate"), "donut.toml").unwrap_err();
-//! assert_eq!((err.line, err.key.as_str()), (9, "objects[0].shape.minor_radius"));
+//! // Line 10: the text starts with a newline.
+//! assert_eq!((err.line, err.key.as_str()), (10, "objects[0].shape.minor_radius"));
 //! ```
 #![deny(missing_docs)]
 
