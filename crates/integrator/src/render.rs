@@ -167,7 +167,7 @@ fn render_tile(estimator: &Estimator<'_>, origin: UVec2) -> (Vec<PixelStats>, Ra
     let settings = estimator.settings;
     let (w, h) = (settings.width, settings.height);
     let (tw, th) = ((w - origin.x).min(TILE), (h - origin.y).min(TILE));
-    let mut sampler = Sampler::new(settings.sampler, settings.seed);
+    let mut sampler = Sampler::for_image(settings.sampler, settings.seed, [w, h], settings.spp);
     let mut counters = RayCounters::default();
     let mut dropped = 0u64;
     let mut pixels = Vec::with_capacity((tw * th) as usize);

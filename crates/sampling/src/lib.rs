@@ -62,6 +62,7 @@ mod frame;
 mod light;
 mod math;
 mod mis;
+pub mod pointsets;
 mod quad_light;
 mod sampler;
 mod sphere_light;

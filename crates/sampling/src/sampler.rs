@@ -7,24 +7,102 @@ use glam::Vec2;
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::Rng;
 
+use crate::pointsets::{
+    HALTON_MAX_DIMENSIONS, SOBOL_MAX_DIMENSIONS, cmj, halton_base, hash2, hash3,
+    nested_uniform_scramble, owen_scrambled_radical_inverse, permute, radical_inverse, sobol_u32,
+};
+
 /// Which point set a [`Sampler`] draws from. An enum, dispatched by `match`,
 /// because the set is closed and the call is in the innermost loop.
+///
+/// Except for the plain constructions ([`SamplerKind::Halton`],
+/// [`SamplerKind::Sobol`]), every kind is randomized per pixel and per
+/// dimension, and "padded" like pbrt-v4's samplers: each 1D or 2D request
+/// is a fresh low-dimensional pattern over the pixel's sample indices,
+/// decorrelated from the other requests by a scramble seed and an index
+/// shuffle hashed from (seed, pixel, dimension), so that high dimensions do
+/// not alias with low ones.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum SamplerKind {
     /// Independent uniform numbers from PCG32 (pbrt-v4 §8.3,
     /// `IndependentSampler`).
     #[default]
     Independent,
+    /// Jittered sampling over the pixel's `spp` samples: a 2D request is one
+    /// point per cell of the most square `columns x rows = spp` grid, a 1D
+    /// request one per `1/spp` stratum; sample indices are assigned to
+    /// strata by a random permutation per (pixel, dimension) (pbrt-v4 §8.5).
+    Stratified,
+    /// Latin hypercube over the pixel's `spp` samples (McKay, Beckman and
+    /// Conover 1979): one sample per `1/spp` stratum in every dimension.
+    Lhs,
+    /// Correlated multi-jittered 2D patterns of `spp` points (Kensler 2013),
+    /// one pattern per (pixel, dimension); 1D requests as
+    /// [`SamplerKind::Stratified`].
+    Cmj,
+    /// The plain Halton sequence over sample indices, dimension `k` in the
+    /// `k`-th prime base (wrapping after 1024), the same in every pixel.
+    /// Unrandomized: its errors are correlated across pixels; here to be
+    /// measured, not to be used.
+    Halton,
+    /// Halton, Owen-scrambled (nested random digit permutations) with a seed
+    /// per (pixel, dimension).
+    HaltonOwen,
+    /// The plain Sobol' sequence over sample indices, dimension `k` of the
+    /// Joe–Kuo table (wrapping after 256), the same in every pixel.
+    /// Unrandomized, like [`SamplerKind::Halton`].
+    Sobol,
+    /// Sobol' (0, 2)-sequence per request, randomized by a digital XOR shift
+    /// and an Owen-scrambled index shuffle per (pixel, dimension).
+    SobolXor,
+    /// Burley 2020's padded Owen-scrambled Sobol': each request is the first
+    /// two Sobol' dimensions (a (0, 2)-sequence), Owen-scrambled with seeds
+    /// hashed from (seed, pixel, dimension), its index shuffled by an Owen
+    /// scramble, which keeps power-of-two prefixes (0, m, 2)-nets.
+    SobolOwen,
+    /// pbrt-v4's `ZSobolSampler` (Ahmed and Wonka 2020, "Screen-space blue
+    /// noise sampling by ordered dithering"; pbrt-v4 §8.7.7): one global
+    /// Owen-scrambled Sobol' sequence indexed by the Morton code of the pixel
+    /// followed by the sample index, with base-4 digits randomly permuted,
+    /// so neighbouring pixels get complementary points and the image error
+    /// is blue noise.
+    ZSobol,
+    /// Roberts's R2 Kronecker sequence for 2D requests and the golden-ratio
+    /// sequence for 1D requests, with a Cranley–Patterson rotation per
+    /// (pixel, dimension).
+    R2,
 }
 
 impl SamplerKind {
     /// Every kind, in a stable order.
-    pub const ALL: &'static [SamplerKind] = &[SamplerKind::Independent];
+    pub const ALL: &'static [SamplerKind] = &[
+        SamplerKind::Independent,
+        SamplerKind::Stratified,
+        SamplerKind::Lhs,
+        SamplerKind::Cmj,
+        SamplerKind::Halton,
+        SamplerKind::HaltonOwen,
+        SamplerKind::Sobol,
+        SamplerKind::SobolXor,
+        SamplerKind::SobolOwen,
+        SamplerKind::ZSobol,
+        SamplerKind::R2,
+    ];
 
     /// The lowercase name used on command lines and in scene files.
     pub fn name(&self) -> &'static str {
         match self {
             SamplerKind::Independent => "independent",
+            SamplerKind::Stratified => "stratified",
+            SamplerKind::Lhs => "lhs",
+            SamplerKind::Cmj => "cmj",
+            SamplerKind::Halton => "halton",
+            SamplerKind::HaltonOwen => "halton-owen",
+            SamplerKind::Sobol => "sobol",
+            SamplerKind::SobolXor => "sobol-xor",
+            SamplerKind::SobolOwen => "sobol-owen",
+            SamplerKind::ZSobol => "zsobol",
+            SamplerKind::R2 => "r2",
         }
     }
 
@@ -51,10 +129,11 @@ pub const DIMENSIONS_PER_SAMPLE: u32 = 65536;
 
 /// A deterministic source of uniform numbers for rendering.
 ///
-/// Every value depends only on (kind, seed, pixel, sample index, dimension):
-/// [`Sampler::start_pixel_sample`] positions the sampler, and each
-/// [`Sampler::next_1d`] moves one dimension on. Threads may therefore render
-/// pixels in any order and the image is bit-identical.
+/// Every value depends only on (kind, seed, image size, spp, pixel, sample
+/// index, dimension, and whether it was asked by [`Sampler::next_1d`] or
+/// [`Sampler::next_2d`]): [`Sampler::start_pixel_sample`] positions the
+/// sampler, `next_1d` moves one dimension on and `next_2d` two. Threads may
+/// therefore render pixels in any order and the image is bit-identical.
 ///
 /// **Stability promise:** the numbers are pinned by the algorithm below and by
 /// golden-value tests, not by a library's choice of default generator, so a
@@ -63,11 +142,21 @@ pub const DIMENSIONS_PER_SAMPLE: u32 = 65536;
 /// `key = pixel.x | pixel.y << 32` and `mix` is the splitmix64 finaliser; the
 /// generator is `Pcg32::new(mix(h), h)` (PCG XSH-RR 64/32, `rand_pcg` 0.10),
 /// advanced by `sample_index * 65536 + dimension`; a value is the top 24 bits
-/// of the output times `2^-24`.
+/// of the output times `2^-24`. Every kind's values are multiples of
+/// `2^-24` in `[0, 1)`.
 #[derive(Clone, Debug)]
 pub struct Sampler {
     kind: SamplerKind,
     seed: u64,
+    /// Samples per pixel, at least 1: the size of the stratified patterns.
+    spp: u32,
+    /// `ceil(log2(spp))`, for ZSobol's Morton index.
+    log2_spp: u32,
+    /// Base-4 digits of ZSobol's Morton index (pbrt-v4's `nBase4Digits`).
+    base4_digits: u32,
+    pixel: [u32; 2],
+    index: u32,
+    dimension: u32,
     rng: Pcg32,
 }
 
@@ -80,13 +169,108 @@ fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// A 32-bit binary fraction as an `f32` in `[0, 1)`: its top 24 bits.
+#[inline]
+fn fraction_to_f32(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// An `f64` in `[0, 1)` rounded down to a multiple of `2^-24`, so that the
+/// `f32` can never round up to 1.
+#[inline]
+fn unit_to_f32(x: f64) -> f32 {
+    ((x * 16_777_216.0) as u32).min((1 << 24) - 1) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// The 64-bit fraction `x / 2^64` as an `f32` in `[0, 1)`.
+#[inline]
+fn fraction64_to_f32(x: u64) -> f32 {
+    (x >> 40) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// Interleaves the bits of `x` and `y` (`x` in the even bits): the Morton
+/// code, Z-order.
+#[inline]
+fn morton2(x: u32, y: u32) -> u64 {
+    fn spread(v: u32) -> u64 {
+        let mut v = u64::from(v);
+        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
+        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
+        (v | (v << 1)) & 0x5555_5555_5555_5555
+    }
+    spread(x) | (spread(y) << 1)
+}
+
+/// The 24 permutations of four base-4 digits (pbrt-v4's `ZSobolSampler`).
+const PERMUTATIONS_4: [[u8; 4]; 24] = [
+    [0, 1, 2, 3],
+    [0, 1, 3, 2],
+    [0, 2, 1, 3],
+    [0, 2, 3, 1],
+    [0, 3, 2, 1],
+    [0, 3, 1, 2],
+    [1, 0, 2, 3],
+    [1, 0, 3, 2],
+    [1, 2, 0, 3],
+    [1, 2, 3, 0],
+    [1, 3, 2, 0],
+    [1, 3, 0, 2],
+    [2, 1, 0, 3],
+    [2, 1, 3, 0],
+    [2, 0, 1, 3],
+    [2, 0, 3, 1],
+    [2, 3, 0, 1],
+    [2, 3, 1, 0],
+    [3, 1, 2, 0],
+    [3, 1, 0, 2],
+    [3, 2, 1, 0],
+    [3, 2, 0, 1],
+    [3, 0, 2, 1],
+    [3, 0, 1, 2],
+];
+
+/// The golden-ratio increment `2^64 / phi` of the 1D Kronecker sequence
+/// (Weyl's, the best-spread rank-1 sequence in 1D).
+const GOLDEN_1D: u64 = 0x9e37_79b9_7f4a_7c15;
+
 impl Sampler {
-    /// A sampler of the given kind and seed, positioned at pixel (0, 0),
-    /// sample 0, dimension 0.
+    /// A sampler of the given kind and seed for an image of unknown size and
+    /// sample count, positioned at pixel (0, 0), sample 0, dimension 0.
+    ///
+    /// It assumes 1 sample per pixel and a 1x1 image: fine for
+    /// [`SamplerKind::Independent`] and the sequences, but the stratified
+    /// kinds then have a single stratum and [`SamplerKind::ZSobol`] gives
+    /// overlapping sequences to neighbouring pixels. A renderer uses
+    /// [`Sampler::for_image`].
     pub fn new(kind: SamplerKind, seed: u64) -> Self {
+        Self::for_image(kind, seed, [1, 1], 1)
+    }
+
+    /// A sampler for an image of `resolution` pixels rendered with `spp`
+    /// samples per pixel (0 counts as 1), positioned at pixel (0, 0), sample
+    /// 0, dimension 0. Sample indices should stay below `spp`: past it the
+    /// stratified kinds start a new, independent pattern, and ZSobol runs
+    /// into the next pixel's samples (best with `spp` a power of two, for
+    /// the Sobol' kinds). ZSobol indexes a 32-bit sequence, so it is meant
+    /// for `width * height * spp <= 2^32` (rounded up to powers of 2 and 4).
+    pub fn for_image(kind: SamplerKind, seed: u64, resolution: [u32; 2], spp: u32) -> Self {
+        let spp = spp.max(1);
+        let log2_spp = spp
+            .checked_next_power_of_two()
+            .map_or(32, |p| p.trailing_zeros());
+        let res = resolution[0].max(resolution[1]).max(1).next_power_of_two();
+        let base4_digits = res.trailing_zeros() + log2_spp.div_ceil(2);
         let mut sampler = Self {
             kind,
             seed,
+            spp,
+            log2_spp,
+            base4_digits,
+            pixel: [0, 0],
+            index: 0,
+            dimension: 0,
             rng: Pcg32::new(0, 0),
         };
         sampler.start_pixel_sample([0, 0], 0, 0);
@@ -106,37 +290,231 @@ impl Sampler {
     /// Positions the sampler so that the next value is dimension `dimension`
     /// of sample `sample_index` of `pixel` (pbrt-v4 `StartPixelSample`).
     pub fn start_pixel_sample(&mut self, pixel: [u32; 2], sample_index: u32, dimension: u32) {
+        self.pixel = pixel;
+        self.index = sample_index;
+        self.dimension = dimension;
+        if self.kind == SamplerKind::Independent {
+            let key = u64::from(pixel[0]) | (u64::from(pixel[1]) << 32);
+            let stream = mix64(key ^ mix64(self.seed.wrapping_add(0x9e37_79b9_7f4a_7c15)));
+            // pbrt-v4's RNG::SetSequence(seq) is Pcg32::new(MixBits(seq), seq).
+            self.rng = Pcg32::new(mix64(stream), stream);
+            self.rng.advance(
+                u64::from(sample_index) * u64::from(DIMENSIONS_PER_SAMPLE) + u64::from(dimension),
+            );
+        }
+    }
+
+    /// The next uniform number, in `[0, 1)`: a multiple of `2^-24`, so 1.0 is
+    /// impossible.
+    #[inline]
+    pub fn next_1d(&mut self) -> f32 {
+        if self.kind == SamplerKind::Independent {
+            return (self.rng.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0);
+        }
+        let value = self.sample_1d();
+        self.dimension = self.dimension.wrapping_add(1);
+        value
+    }
+
+    /// The next two uniform numbers (two dimensions, `x` first). For the
+    /// structured kinds the pair is one point of a 2D pattern, which is why
+    /// it is not the same as two calls of [`Sampler::next_1d`].
+    #[inline]
+    pub fn next_2d(&mut self) -> Vec2 {
+        if self.kind == SamplerKind::Independent {
+            let x = self.next_1d();
+            let y = self.next_1d();
+            return Vec2::new(x, y);
+        }
+        let value = self.sample_2d();
+        self.dimension = self.dimension.wrapping_add(2);
+        value
+    }
+
+    /// The scramble seed of the current (pixel, dimension), and of the
+    /// block of `spp` sample indices the current index is in, so that
+    /// indices past `spp` start an independent pattern.
+    #[inline]
+    fn request_hash(&self) -> u64 {
+        let key = u64::from(self.pixel[0]) | (u64::from(self.pixel[1]) << 32);
+        let block = self.index / self.spp;
+        hash2(
+            hash3(self.seed, key, u64::from(self.dimension)),
+            u64::from(block),
+        )
+    }
+
+    /// Pixel-wide seed of `dimension`, without the index block: for the
+    /// sequences, whose index is used whole.
+    #[inline]
+    fn sequence_hash(&self, dimension: u32) -> u64 {
+        let key = u64::from(self.pixel[0]) | (u64::from(self.pixel[1]) << 32);
+        hash3(self.seed, key, u64::from(dimension))
+    }
+
+    /// Dimension `dimension` of the plain or scrambled Halton or Sobol'
+    /// sequence at the current sample index.
+    fn sequence_1d(&self, dimension: u32) -> f32 {
+        let index = self.index;
         match self.kind {
-            SamplerKind::Independent => {
-                let key = u64::from(pixel[0]) | (u64::from(pixel[1]) << 32);
-                let stream = mix64(key ^ mix64(self.seed.wrapping_add(0x9e37_79b9_7f4a_7c15)));
-                // pbrt-v4's RNG::SetSequence(seq) is Pcg32::new(MixBits(seq), seq).
-                self.rng = Pcg32::new(mix64(stream), stream);
-                self.rng.advance(
-                    u64::from(sample_index) * u64::from(DIMENSIONS_PER_SAMPLE)
-                        + u64::from(dimension),
-                );
+            SamplerKind::Halton => unit_to_f32(radical_inverse(
+                halton_base(dimension as usize % HALTON_MAX_DIMENSIONS),
+                u64::from(index),
+            )),
+            SamplerKind::HaltonOwen => unit_to_f32(owen_scrambled_radical_inverse(
+                halton_base(dimension as usize % HALTON_MAX_DIMENSIONS),
+                u64::from(index),
+                self.sequence_hash(dimension),
+            )),
+            _ => fraction_to_f32(sobol_u32(index, dimension as usize % SOBOL_MAX_DIMENSIONS)),
+        }
+    }
+
+    /// The current sample's index within its pattern of `spp` points.
+    #[inline]
+    fn index_in_pattern(&self) -> u32 {
+        self.index % self.spp
+    }
+
+    /// A stratified 1D value: stratum `permute(index)` of `spp`, jittered.
+    #[inline]
+    fn stratified_1d(&self) -> f32 {
+        let h = self.request_hash();
+        let stratum = permute(self.index_in_pattern(), self.spp, h as u32);
+        let jitter = crate::pointsets::kensler_unit(stratum, (h >> 32) as u32);
+        unit_to_f32((f64::from(stratum) + jitter) / f64::from(self.spp))
+    }
+
+    fn sample_1d(&self) -> f32 {
+        match self.kind {
+            SamplerKind::Independent => unreachable!("handled by next_1d"),
+            SamplerKind::Stratified | SamplerKind::Lhs | SamplerKind::Cmj => self.stratified_1d(),
+            SamplerKind::Halton | SamplerKind::HaltonOwen | SamplerKind::Sobol => {
+                self.sequence_1d(self.dimension)
+            }
+            SamplerKind::SobolXor | SamplerKind::SobolOwen => {
+                fraction_to_f32(self.padded_sobol::<1>()[0])
+            }
+            SamplerKind::ZSobol => fraction_to_f32(self.zsobol()[0]),
+            SamplerKind::R2 => {
+                let shift = self.sequence_hash(self.dimension);
+                fraction64_to_f32(shift.wrapping_add(u64::from(self.index).wrapping_mul(GOLDEN_1D)))
             }
         }
     }
 
-    /// The next uniform number, in `[0, 1)`: 24 random bits, so every value
-    /// is an exact multiple of `2^-24` and 1.0 is impossible.
-    #[inline]
-    pub fn next_1d(&mut self) -> f32 {
+    fn sample_2d(&self) -> Vec2 {
         match self.kind {
-            SamplerKind::Independent => (self.rng.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0),
+            SamplerKind::Independent => unreachable!("handled by next_2d"),
+            SamplerKind::Stratified => {
+                let h = self.request_hash();
+                let j = permute(self.index_in_pattern(), self.spp, h as u32);
+                let [x, y] = crate::pointsets::jittered_2d(j as usize, self.spp as usize, h);
+                Vec2::new(unit_to_f32(x), unit_to_f32(y))
+            }
+            SamplerKind::Lhs => {
+                let h = self.request_hash();
+                let (i, n) = (self.index_in_pattern() as usize, self.spp as usize);
+                Vec2::new(
+                    unit_to_f32(crate::pointsets::latin_hypercube(i, n, 0, h)),
+                    unit_to_f32(crate::pointsets::latin_hypercube(i, n, 1, h)),
+                )
+            }
+            SamplerKind::Cmj => {
+                let h = self.request_hash();
+                let [x, y] = cmj(self.index_in_pattern(), self.spp, h as u32);
+                Vec2::new(unit_to_f32(x), unit_to_f32(y))
+            }
+            SamplerKind::Halton | SamplerKind::HaltonOwen | SamplerKind::Sobol => {
+                // Consecutive dimensions of one sequence.
+                Vec2::new(
+                    self.sequence_1d(self.dimension),
+                    self.sequence_1d(self.dimension.wrapping_add(1)),
+                )
+            }
+            SamplerKind::SobolXor | SamplerKind::SobolOwen => {
+                let [x, y] = self.padded_sobol::<2>();
+                Vec2::new(fraction_to_f32(x), fraction_to_f32(y))
+            }
+            SamplerKind::ZSobol => {
+                let [x, y] = self.zsobol();
+                Vec2::new(fraction_to_f32(x), fraction_to_f32(y))
+            }
+            SamplerKind::R2 => {
+                let shift = self.sequence_hash(self.dimension);
+                let i = u64::from(self.index);
+                let [ax, ay] = R2_INCREMENTS;
+                Vec2::new(
+                    fraction64_to_f32(shift.wrapping_add(i.wrapping_mul(ax))),
+                    fraction64_to_f32(hash2(shift, 1).wrapping_add(i.wrapping_mul(ay))),
+                )
+            }
         }
     }
 
-    /// The next two uniform numbers (two dimensions, `x` first).
+    /// The first `N` (1 or 2) Sobol' dimensions at a shuffled index,
+    /// randomized by XOR or Owen scrambling (Burley 2020, Listing 3, in 2D).
     #[inline]
-    pub fn next_2d(&mut self) -> Vec2 {
-        let x = self.next_1d();
-        let y = self.next_1d();
-        Vec2::new(x, y)
+    fn padded_sobol<const N: usize>(&self) -> [u32; N] {
+        let h = self.sequence_hash(self.dimension);
+        let index = nested_uniform_scramble(self.index, h as u32);
+        let seeds = [(h >> 32) as u32, hash2(h, 1) as u32];
+        std::array::from_fn(|k| {
+            let x = sobol_u32(index, k);
+            if self.kind == SamplerKind::SobolXor {
+                x ^ seeds[k]
+            } else {
+                nested_uniform_scramble(x, seeds[k])
+            }
+        })
+    }
+
+    /// pbrt-v4's `ZSobolSampler::Get1D/Get2D`: Owen-scrambled Sobol' (0, 2)
+    /// point at the randomly permuted Morton index, with scramble seeds
+    /// depending on the dimension and seed only (the pixel enters through
+    /// the index).
+    #[inline]
+    fn zsobol(&self) -> [u32; 2] {
+        let index = self.zsobol_index() as u32;
+        let h = hash2(self.seed, u64::from(self.dimension));
+        [
+            nested_uniform_scramble(sobol_u32(index, 0), h as u32),
+            nested_uniform_scramble(sobol_u32(index, 1), (h >> 32) as u32),
+        ]
+    }
+
+    /// pbrt-v4's `ZSobolSampler::GetSampleIndex`: the Morton index of
+    /// (pixel, sample) with each base-4 digit permuted by one of the 24
+    /// permutations, chosen by hashing the digits above it and the
+    /// dimension. Nested like Owen scrambling, so the samples of a pixel
+    /// stay an aligned block of the sequence (a net for power-of-two spp),
+    /// while neighbouring pixels get complementary blocks.
+    fn zsobol_index(&self) -> u64 {
+        let morton =
+            (morton2(self.pixel[0], self.pixel[1]) << self.log2_spp) | u64::from(self.index);
+        let dimension_key = hash2(self.seed, u64::from(self.dimension));
+        let odd = self.log2_spp & 1 == 1;
+        let last_digit = u32::from(odd);
+        let mut index = 0u64;
+        for i in (last_digit..self.base4_digits).rev() {
+            let shift = 2 * i - u32::from(odd);
+            let digit = (morton >> shift) & 3;
+            let higher = morton.checked_shr(shift + 2).unwrap_or(0);
+            let p = (mix64(higher ^ dimension_key) >> 24) % 24;
+            index |= u64::from(PERMUTATIONS_4[p as usize][digit as usize]) << shift;
+        }
+        if odd {
+            let digit = morton & 1;
+            index |= digit ^ (mix64((morton >> 1) ^ dimension_key) & 1);
+        }
+        index
     }
 }
+
+/// R2's increments `1/phi_2` and `1/phi_2^2` (`phi_2 = 1.3247179572...`,
+/// the plastic number) as 64-bit fractions, computed to 60 digits (the
+/// unit tests check them against [`crate::pointsets`]' Newton iteration).
+const R2_INCREMENTS: [u64; 2] = [0xc13f_a9a9_02a6_328f, 0x91e1_0da5_c79e_7b1c];
 
 #[cfg(test)]
 mod tests {
@@ -152,7 +530,34 @@ mod tests {
             SamplerKind::from_name("Independent"),
             Some(SamplerKind::Independent)
         );
-        assert_eq!(SamplerKind::from_name("sobol"), None);
+        assert_eq!(SamplerKind::from_name("ZSOBOL"), Some(SamplerKind::ZSobol));
+        assert_eq!(SamplerKind::from_name("pmj02"), None);
+        assert_eq!(SamplerKind::default(), SamplerKind::Independent);
+    }
+
+    #[test]
+    fn kronecker_constants_match_newton() {
+        let [x, y] = crate::pointsets::kronecker_increments(2)[..] else {
+            panic!("two increments");
+        };
+        // The f64 route has 53 significant bits; the constants 64.
+        for (constant, newton) in [(R2_INCREMENTS[0], x), (R2_INCREMENTS[1], y)] {
+            assert!(
+                constant.abs_diff(newton) < 1 << 12,
+                "{constant:#x} {newton:#x}"
+            );
+        }
+        let golden = crate::pointsets::kronecker_increments(1)[0];
+        assert!(GOLDEN_1D.abs_diff(golden) < 1 << 12);
+    }
+
+    #[test]
+    fn morton_interleaves_x_in_even_bits() {
+        assert_eq!(morton2(0, 0), 0);
+        assert_eq!(morton2(1, 0), 1);
+        assert_eq!(morton2(0, 1), 2);
+        assert_eq!(morton2(3, 5), 0b10_01_11);
+        assert_eq!(morton2(u32::MAX, 0), 0x5555_5555_5555_5555);
     }
 
     #[test]

@@ -30,3 +30,11 @@ mod mis;
 /// The renderer-side sampler: determinism, independence, uniformity, golden
 /// values.
 mod sampler;
+
+/// The point-set library: generators in [0, 1), nets and strata, published
+/// Sobol' and Halton points, discrepancies against closed forms and SciPy.
+mod pointsets;
+
+/// Every kind of the renderer's sampler: determinism in any order, nets and
+/// strata per pixel, decorrelated dimensions, ZSobol's complementary pixels.
+mod sampler_kinds;

@@ -1,0 +1,435 @@
+//! Point sets in the unit cube `[0, 1)^d`, reusable on their own: random,
+//! stratified, low-discrepancy and blue-noise generators behind one call,
+//! [`generate`], and the measures that compare them (L2 discrepancies and
+//! the exact 2D star discrepancy).
+//!
+//! The design decision: every coordinate is a pure function of (kind, seed,
+//! point index, dimension), computed from integer hashes or from the
+//! point's index, never from a generator's running state (the only
+//! exceptions are [`PointSetKind::Independent`], a PCG32 stream, and
+//! [`PointSetKind::PoissonDisk`], whose points depend on each other by
+//! construction). That is what lets the renderer's `Sampler` ask for sample
+//! `i` of a pixel in any order, and what makes randomizations independent:
+//! two seeds give two independent randomizations of the same construction,
+//! over which errors can be averaged.
+//!
+//! **Contract.** [`generate`] returns exactly `n` points of `dim`
+//! coordinates, each in `[0, 1)` (never 1), the same ones for the same
+//! arguments on every platform, or a typed [`PointSetError`] when the kind
+//! cannot make that many points or dimensions.
+//!
+//! ```
+//! use lueur_sampling::pointsets::{PointSetKind, generate, l2_star_discrepancy};
+//!
+//! let sobol = generate(PointSetKind::SobolOwen, 256, 2, 7).unwrap();
+//! let random = generate(PointSetKind::Independent, 256, 2, 7).unwrap();
+//! assert_eq!(sobol.point(3).len(), 2);
+//! assert!(l2_star_discrepancy(&sobol) < l2_star_discrepancy(&random));
+//! ```
+
+use std::fmt;
+
+use rand_pcg::Pcg32;
+use rand_pcg::rand_core::Rng;
+
+mod halton;
+mod hash;
+mod kronecker;
+mod metrics;
+mod poisson;
+mod sobol;
+mod stratified;
+
+pub use halton::{
+    HALTON_MAX_DIMENSIONS, halton_base, owen_scrambled_radical_inverse, radical_inverse,
+};
+pub use kronecker::generalized_golden_ratio;
+pub use metrics::{
+    centered_l2_discrepancy, l2_star_discrepancy, star_discrepancy_2d, wraparound_l2_discrepancy,
+};
+pub use poisson::{poisson_disk_max_radius, toroidal_distance};
+pub use sobol::{
+    SOBOL_MAX_DIMENSIONS, laine_karras_permutation, nested_uniform_scramble, sobol_owen_u32,
+    sobol_u32,
+};
+pub use stratified::strata_shape;
+
+pub(crate) use hash::{hash2, hash3, kensler_unit, permute};
+#[cfg(test)]
+pub(crate) use kronecker::increments as kronecker_increments;
+pub(crate) use stratified::{cmj, jittered_2d, latin_hypercube};
+
+use hash::{u32_to_unit, u64_to_unit};
+
+/// The generators. An enum, dispatched by `match`: the set is closed and
+/// each kind is one algorithm.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PointSetKind {
+    /// Independent uniform points from PCG32 (O'Neill 2014, "PCG: A family of
+    /// simple fast space-efficient statistically good algorithms for random
+    /// number generation"). The baseline every other kind is measured
+    /// against.
+    Independent,
+    /// Jittered (stratified) sampling: one point uniformly in each cell of a
+    /// [`strata_shape`] grid. Dimensions are paired, `(0, 1)`, `(2, 3)`...,
+    /// each pair an independent jittered pattern whose points are shuffled
+    /// by a random permutation (padding, as pbrt-v4 §8.5 does), and an odd
+    /// last dimension is a shuffled 1D jitter.
+    Stratified,
+    /// Latin hypercube sampling (McKay, Beckman and Conover 1979): in every
+    /// dimension, each of the `n` strata holds one point.
+    LatinHypercube,
+    /// Correlated multi-jittered sampling (Kensler 2013), padded by pairs
+    /// like [`PointSetKind::Stratified`], each pair its own pattern.
+    Cmj,
+    /// The Halton sequence: radical inverses in the first primes (Halton
+    /// 1960), unscrambled; starts at the origin. Seed ignored.
+    Halton,
+    /// Halton with nested (Owen) random digit permutations per dimension.
+    HaltonOwen,
+    /// The Sobol' sequence with Joe–Kuo direction numbers, unscrambled, in
+    /// natural order; starts at the origin. Seed ignored.
+    Sobol,
+    /// Sobol' with a random digital shift: every coordinate XORed with a
+    /// per-dimension random 32-bit word (a (t, m, s)-net stays one).
+    SobolXor,
+    /// Sobol' with hash-based nested uniform (Owen) scrambling per
+    /// dimension (Burley 2020).
+    SobolOwen,
+    /// The rank-1 Kronecker sequence R_d (Roberts 2018; "R2" in 2D) with a
+    /// random Cranley–Patterson rotation.
+    R2,
+    /// A 2D Poisson-disk set by relaxation dart throwing on the torus
+    /// (McCool and Fiume 1992): blue noise. 2D only.
+    PoissonDisk,
+}
+
+impl PointSetKind {
+    /// Every kind, in a stable order.
+    pub const ALL: &'static [PointSetKind] = &[
+        PointSetKind::Independent,
+        PointSetKind::Stratified,
+        PointSetKind::LatinHypercube,
+        PointSetKind::Cmj,
+        PointSetKind::Halton,
+        PointSetKind::HaltonOwen,
+        PointSetKind::Sobol,
+        PointSetKind::SobolXor,
+        PointSetKind::SobolOwen,
+        PointSetKind::R2,
+        PointSetKind::PoissonDisk,
+    ];
+
+    /// The lowercase name used on command lines (the renderer's
+    /// `SamplerKind` uses the same names for the kinds it shares).
+    pub fn name(&self) -> &'static str {
+        match self {
+            PointSetKind::Independent => "independent",
+            PointSetKind::Stratified => "stratified",
+            PointSetKind::LatinHypercube => "lhs",
+            PointSetKind::Cmj => "cmj",
+            PointSetKind::Halton => "halton",
+            PointSetKind::HaltonOwen => "halton-owen",
+            PointSetKind::Sobol => "sobol",
+            PointSetKind::SobolXor => "sobol-xor",
+            PointSetKind::SobolOwen => "sobol-owen",
+            PointSetKind::R2 => "r2",
+            PointSetKind::PoissonDisk => "poisson-disk",
+        }
+    }
+
+    /// The kind called `s` (ASCII case-insensitive), if any.
+    pub fn from_name(s: &str) -> Option<Self> {
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|kind| kind.name().eq_ignore_ascii_case(s))
+    }
+
+    /// The most dimensions this kind can generate, if bounded.
+    pub fn max_dimensions(&self) -> Option<usize> {
+        match self {
+            PointSetKind::Halton | PointSetKind::HaltonOwen => Some(HALTON_MAX_DIMENSIONS),
+            PointSetKind::Sobol | PointSetKind::SobolXor | PointSetKind::SobolOwen => {
+                Some(SOBOL_MAX_DIMENSIONS)
+            }
+            PointSetKind::PoissonDisk => Some(2),
+            _ => None,
+        }
+    }
+
+    /// The most points this kind can generate, if bounded: `2^32` for the
+    /// kinds indexed by 32-bit integers (Sobol' matrices, Kensler's
+    /// permutations).
+    pub fn max_points(&self) -> Option<u64> {
+        match self {
+            PointSetKind::Sobol
+            | PointSetKind::SobolXor
+            | PointSetKind::SobolOwen
+            | PointSetKind::LatinHypercube
+            | PointSetKind::Cmj
+            | PointSetKind::Stratified => Some(1 << 32),
+            _ => None,
+        }
+    }
+}
+
+impl fmt::Display for PointSetKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Why a point set could not be made or read.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PointSetError {
+    /// A point set has at least one dimension.
+    #[error("a point set needs at least one dimension")]
+    ZeroDimensions,
+    /// More dimensions than the kind's tables hold.
+    #[error("{kind} supports at most {max} dimensions, {dim} were asked")]
+    TooManyDimensions {
+        /// The generator.
+        kind: PointSetKind,
+        /// Dimensions asked for.
+        dim: usize,
+        /// The kind's limit.
+        max: usize,
+    },
+    /// A construction or measure defined only in some dimensions.
+    #[error("{what} is only defined in {supported} dimensions, {dim} were asked")]
+    UnsupportedDimensions {
+        /// The generator or measure.
+        what: &'static str,
+        /// Dimensions asked for.
+        dim: usize,
+        /// The dimensions it supports, in words.
+        supported: &'static str,
+    },
+    /// More points than the kind can index.
+    #[error("{kind} supports at most {max} points, {n} were asked")]
+    TooManyPoints {
+        /// The generator.
+        kind: PointSetKind,
+        /// Points asked for.
+        n: usize,
+        /// The kind's limit.
+        max: u64,
+    },
+    /// Coordinates that do not split into whole points.
+    #[error("{len} coordinates do not make whole points of {dim} dimensions")]
+    RaggedData {
+        /// Number of coordinates given.
+        len: usize,
+        /// Dimensions per point.
+        dim: usize,
+    },
+    /// A coordinate outside `[0, 1)` (or NaN).
+    #[error("coordinate {index} is {value}, outside [0, 1)")]
+    OutsideUnitCube {
+        /// Index of the coordinate in the row-major data.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
+}
+
+/// `n` points of `[0, 1)^dim`, stored row-major: coordinate `k` of point `i`
+/// is `data[i * dim + k]`.
+///
+/// Invariant: `dim >= 1`, `data.len() = n * dim`, every coordinate in
+/// `[0, 1)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointSet {
+    dim: usize,
+    data: Vec<f64>,
+}
+
+impl PointSet {
+    /// Wraps row-major coordinates (from a file, another library...), checking
+    /// the invariant, so they can be measured like generated ones.
+    pub fn new(dim: usize, data: Vec<f64>) -> Result<Self, PointSetError> {
+        if dim == 0 {
+            return Err(PointSetError::ZeroDimensions);
+        }
+        if data.len() % dim != 0 {
+            return Err(PointSetError::RaggedData {
+                len: data.len(),
+                dim,
+            });
+        }
+        if let Some((index, &value)) = data
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !(0.0..1.0).contains(*v))
+        {
+            return Err(PointSetError::OutsideUnitCube { index, value });
+        }
+        Ok(Self { dim, data })
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.data.len() / self.dim
+    }
+
+    /// True when there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+
+    /// Coordinates per point.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// The coordinates of point `i`. Panics if `i >= len()`.
+    pub fn point(&self, i: usize) -> &[f64] {
+        &self.data[i * self.dim..(i + 1) * self.dim]
+    }
+
+    /// The points in order, each a slice of `dim` coordinates.
+    pub fn points(&self) -> std::slice::ChunksExact<'_, f64> {
+        self.data.chunks_exact(self.dim)
+    }
+
+    /// All coordinates, row-major.
+    pub fn as_slice(&self) -> &[f64] {
+        &self.data
+    }
+
+    /// The row-major coordinates, consuming the set.
+    pub fn into_vec(self) -> Vec<f64> {
+        self.data
+    }
+}
+
+/// `n` points of `[0, 1)^dim` from generator `kind`, randomized by `seed`
+/// (ignored by the deterministic constructions [`PointSetKind::Halton`] and
+/// [`PointSetKind::Sobol`]).
+///
+/// For the sequences (Halton, Sobol', R2) the result is the first `n` points,
+/// so a prefix of a larger set is the smaller set; for the others (jittered,
+/// Latin hypercube, CMJ, Poisson disk) the construction depends on `n`.
+/// Sobol' points are (0, m, 2)-nets in their first two dimensions when
+/// `n = 2^m`, scrambled or not.
+pub fn generate(
+    kind: PointSetKind,
+    n: usize,
+    dim: usize,
+    seed: u64,
+) -> Result<PointSet, PointSetError> {
+    if dim == 0 {
+        return Err(PointSetError::ZeroDimensions);
+    }
+    if let Some(max) = kind.max_dimensions() {
+        if kind == PointSetKind::PoissonDisk && dim != 2 {
+            return Err(PointSetError::UnsupportedDimensions {
+                what: "poisson-disk",
+                dim,
+                supported: "2",
+            });
+        }
+        if dim > max {
+            return Err(PointSetError::TooManyDimensions { kind, dim, max });
+        }
+    }
+    if let Some(max) = kind.max_points().filter(|&max| n as u64 > max) {
+        return Err(PointSetError::TooManyPoints { kind, n, max });
+    }
+    let mut data = vec![0.0; n * dim];
+    // Seeds of the randomizations: one word per (seed, dimension or pair),
+    // hashed so that nearby seeds and dimensions give unrelated scrambles.
+    let dim_seed = |k: usize| hash2(seed, k as u64);
+    match kind {
+        PointSetKind::Independent => {
+            let state = hash2(seed, 0x0069_6e64_6570);
+            let mut rng = Pcg32::new(state, hash2(state, 1));
+            for x in &mut data {
+                *x = u64_to_unit(rng.next_u64());
+            }
+        }
+        PointSetKind::Stratified | PointSetKind::Cmj => {
+            for pair in 0..dim.div_ceil(2) {
+                let pair_seed = dim_seed(pair);
+                // The first pair keeps its natural order; the others are
+                // shuffled so that no pair is aligned with another.
+                let order = |i: usize| {
+                    if pair == 0 {
+                        i
+                    } else {
+                        permute(i as u32, n as u32, (pair_seed >> 32) as u32) as usize
+                    }
+                };
+                let two = 2 * pair + 1 < dim;
+                for i in 0..n {
+                    let j = order(i);
+                    let p = if kind == PointSetKind::Cmj {
+                        cmj(j as u32, n as u32, pair_seed as u32)
+                    } else if two {
+                        stratified::jittered_2d(j, n, pair_seed)
+                    } else {
+                        [stratified::jittered_1d(j, n, pair_seed), 0.0]
+                    };
+                    data[i * dim + 2 * pair] = p[0];
+                    if two {
+                        data[i * dim + 2 * pair + 1] = p[1];
+                    }
+                }
+            }
+        }
+        PointSetKind::LatinHypercube => {
+            for k in 0..dim {
+                for i in 0..n {
+                    data[i * dim + k] = stratified::latin_hypercube(i, n, k, seed);
+                }
+            }
+        }
+        PointSetKind::Halton => {
+            for k in 0..dim {
+                let base = halton_base(k);
+                for i in 0..n {
+                    data[i * dim + k] = radical_inverse(base, i as u64);
+                }
+            }
+        }
+        PointSetKind::HaltonOwen => {
+            for k in 0..dim {
+                let (base, scramble) = (halton_base(k), dim_seed(k));
+                for i in 0..n {
+                    data[i * dim + k] = owen_scrambled_radical_inverse(base, i as u64, scramble);
+                }
+            }
+        }
+        PointSetKind::Sobol | PointSetKind::SobolXor | PointSetKind::SobolOwen => {
+            for k in 0..dim {
+                let scramble = dim_seed(k) as u32;
+                for i in 0..n {
+                    let x = sobol_u32(i as u32, k);
+                    let x = match kind {
+                        PointSetKind::SobolXor => x ^ scramble,
+                        PointSetKind::SobolOwen => nested_uniform_scramble(x, scramble),
+                        _ => x,
+                    };
+                    data[i * dim + k] = u32_to_unit(x);
+                }
+            }
+        }
+        PointSetKind::R2 => {
+            let increments = kronecker::increments(dim);
+            for (k, &a) in increments.iter().enumerate() {
+                let shift = dim_seed(k);
+                for i in 0..n {
+                    data[i * dim + k] = u64_to_unit(shift.wrapping_add((i as u64).wrapping_mul(a)));
+                }
+            }
+        }
+        PointSetKind::PoissonDisk => {
+            for (i, p) in poisson::poisson_disk_2d(n, seed).into_iter().enumerate() {
+                data[2 * i] = p[0];
+                data[2 * i + 1] = p[1];
+            }
+        }
+    }
+    Ok(PointSet { dim, data })
+}
