@@ -3,6 +3,7 @@
 //! every decision about light lives in `lueur-integrator`.
 
 mod output;
+mod stats;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -10,7 +11,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use lueur_integrator::{RenderOutput, RenderSettings, Strategy, render};
+use lueur_integrator::{Marching, RenderOutput, RenderSettings, Strategy, render};
 use lueur_sampling::SamplerKind;
 use lueur_scene::{SceneFileError, parse_scene};
 
@@ -73,6 +74,10 @@ struct RenderArgs {
     /// Print statistics after the render: rays, steps per ray, hit shares.
     #[arg(long)]
     stats: bool,
+    /// March rays the naive way (plain sphere tracing, no bounding spheres): the
+    /// reference that speed-ups are measured against.
+    #[arg(long)]
+    naive: bool,
 }
 
 fn parse_strategy(s: &str) -> Result<Strategy, String> {
@@ -131,7 +136,10 @@ fn run_render(args: RenderArgs) -> Result<()> {
     let text = std::fs::read_to_string(&args.scene)
         .map_err(|e| BadInput(format!("cannot read scene file {file}: {e}")))?;
     let parsed = parse_scene(&text, &file)?;
-    let scene = parsed.scene;
+    let mut scene = parsed.scene;
+    if args.naive {
+        scene.marching = Marching::Naive;
+    }
     let settings = apply_flags(parsed.settings, &args)?;
     let out = match &args.out {
         Some(p) => p.clone(),
@@ -183,7 +191,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
         );
     }
     if args.stats {
-        print_stats(&output);
+        stats::print_stats(&output);
     }
     Ok(())
 }
@@ -222,31 +230,4 @@ fn default_output(scene: &Path) -> PathBuf {
         .file_stem()
         .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
     PathBuf::from(format!("{stem}.png"))
-}
-
-fn print_stats(out: &RenderOutput) {
-    let s = &out.stats;
-    let secs = s.elapsed.as_secs_f64().max(1e-9);
-    println!(
-        "samples          {:>14}  ({:.3} M/s)",
-        s.samples,
-        s.samples as f64 / secs / 1e6
-    );
-    println!("dropped (NaN/Inf){:>14}", s.dropped_samples);
-    for (name, c) in [
-        ("camera", &s.rays.camera),
-        ("bounce", &s.rays.bounce),
-        ("shadow", &s.rays.shadow),
-    ] {
-        let rays = c.rays.max(1) as f64;
-        println!(
-            "{name:<7} rays {:>12}  ({:.3} M/s)  steps/ray {:>6.1}  hit {:>5.1}%  miss {:>5.1}%  gave up {:>5.2}%",
-            c.rays,
-            c.rays as f64 / secs / 1e6,
-            c.steps as f64 / rays,
-            100.0 * c.hits as f64 / rays,
-            100.0 * c.misses as f64 / rays,
-            100.0 * c.gave_up as f64 / rays,
-        );
-    }
 }

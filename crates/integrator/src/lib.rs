@@ -54,7 +54,7 @@ pub use camera::Camera;
 pub use film::{Film, PixelStats};
 pub use path::RayCounters;
 pub use render::{RenderOutput, RenderSettings, RenderStats, render};
-pub use scene::{Hit, Light, Object, QuadSampling, Scene, TraceCounters};
+pub use scene::{Hit, Light, Marching, Object, QuadSampling, Scene, TraceCounters};
 pub use strategy::Strategy;
 
 /// A scene that cannot be rendered as given.

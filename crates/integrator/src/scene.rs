@@ -8,7 +8,10 @@ use lueur_sampling::{
     quad_solid_angle_pdf, sample_cosine_hemisphere, sample_quad_area, sample_quad_solid_angle,
     sample_sphere_light, sphere_light_pdf,
 };
-use lueur_sdf_math::{DistanceField, Ray, Sdf, TraceOutcome, TraceParams, sphere_trace};
+use lueur_sdf_math::{
+    DistanceField, OVER_RELAXATION, Ray, Sdf, TraceOutcome, TraceParams, sphere_trace,
+    sphere_trace_relaxed,
+};
 
 use crate::{Camera, SceneError};
 
@@ -76,6 +79,22 @@ pub enum QuadSampling {
     SolidAngle,
 }
 
+/// How rays are marched through the objects.
+///
+/// Both modes find the same surfaces (tests hold them to it); `Naive` is kept as the
+/// reference every speed-up is measured against, in the same run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Marching {
+    /// Plain Hart sphere tracing on the plain union of the objects: every step evaluates
+    /// every object.
+    Naive,
+    /// Over-relaxed sphere tracing (Keinert et al. 2014) on the union with bounding-sphere
+    /// culling: an object whose bounding sphere is farther than the nearest object found so
+    /// far costs one distance to a sphere, not its own evaluation.
+    #[default]
+    Fast,
+}
+
 /// A complete scene, ready to render.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -91,6 +110,8 @@ pub struct Scene {
     pub camera: Camera,
     /// How quad lights are sampled.
     pub quad_sampling: QuadSampling,
+    /// How rays are marched through the objects.
+    pub marching: Marching,
     // Derived at construction.
     geometry: Geometry,
     /// Which samplable emitters exist: indices into `lights`, then the sky.
@@ -111,11 +132,51 @@ pub(crate) enum Emitter {
 pub(crate) struct Geometry {
     sdfs: Vec<Sdf>,
     lipschitz: f32,
+    /// Objects evaluated at every point: those without a bounding sphere (planes) and
+    /// those no dearer than their bound (spheres), first, so that the running minimum is
+    /// small before the culled objects are reached.
+    always: Vec<usize>,
+    /// The other objects with their bounding spheres, in scene order.
+    culled: Vec<Bounded>,
 }
 
-impl DistanceField for Geometry {
+/// An object with its bounding sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Bounded {
+    center: Vec3,
+    radius: f32,
+    object: usize,
+}
+
+impl Geometry {
+    fn new(objects: &[Object]) -> Geometry {
+        let lipschitz = objects
+            .iter()
+            .map(|o| o.sdf.lipschitz())
+            .fold(1.0f32, f32::max);
+        let mut always = Vec::new();
+        let mut culled = Vec::new();
+        for (object, o) in objects.iter().enumerate() {
+            match o.sdf.bounding_sphere() {
+                Some((center, radius)) if !is_sphere(&o.sdf) => culled.push(Bounded {
+                    center,
+                    radius,
+                    object,
+                }),
+                _ => always.push(object),
+            }
+        }
+        Geometry {
+            sdfs: objects.iter().map(|o| o.sdf.clone()).collect(),
+            lipschitz,
+            always,
+            culled,
+        }
+    }
+
+    /// The plain union: every object, every time.
     #[inline]
-    fn distance(&self, p: Vec3) -> f32 {
+    fn distance_naive(&self, p: Vec3) -> f32 {
         let mut d = f32::INFINITY;
         for sdf in &self.sdfs {
             d = d.min(sdf.distance(p));
@@ -123,8 +184,64 @@ impl DistanceField for Geometry {
         d
     }
 
+    /// The same value with bounding-sphere culling. Every `Sdf` honours its bounding
+    /// sphere (`f(p) >= |p - c| - r`, a conformance test of `lueur-sdf-math`), so an object
+    /// with `|p - c| - r >= d`, the running minimum, cannot lower it and is skipped: the
+    /// result is the plain union's minimum, not an approximation of it, and therefore
+    /// Lipschitz with the same bound.
+    #[inline]
+    fn distance_culled(&self, p: Vec3) -> f32 {
+        let mut d = f32::INFINITY;
+        for &i in &self.always {
+            d = d.min(self.sdfs[i].distance(p));
+        }
+        for b in &self.culled {
+            // |p - c| - r >= d without a square root: always true when r + d <= 0.
+            let reach = b.radius + d;
+            if reach <= 0.0 || (p - b.center).length_squared() >= reach * reach {
+                continue;
+            }
+            d = d.min(self.sdfs[b.object].distance(p));
+        }
+        d
+    }
+}
+
+/// Whether the shape is a sphere, possibly moved: its bounding sphere is the shape itself,
+/// so checking the bound would cost as much as evaluating it.
+fn is_sphere(sdf: &Sdf) -> bool {
+    match sdf {
+        Sdf::Sphere { .. } => true,
+        Sdf::Translate { child, .. } => is_sphere(child),
+        _ => false,
+    }
+}
+
+/// [`Geometry`] as the plain union, for naive marching.
+struct Naive<'a>(&'a Geometry);
+
+impl DistanceField for Naive<'_> {
+    #[inline]
+    fn distance(&self, p: Vec3) -> f32 {
+        self.0.distance_naive(p)
+    }
+
     fn lipschitz(&self) -> f32 {
-        self.lipschitz
+        self.0.lipschitz
+    }
+}
+
+/// [`Geometry`] with bounding-sphere culling, for fast marching.
+struct Culled<'a>(&'a Geometry);
+
+impl DistanceField for Culled<'_> {
+    #[inline]
+    fn distance(&self, p: Vec3) -> f32 {
+        self.0.distance_culled(p)
+    }
+
+    fn lipschitz(&self) -> f32 {
+        self.0.lipschitz
     }
 }
 
@@ -248,14 +365,7 @@ impl Scene {
         {
             return Err(SceneError::InvalidSky);
         }
-        let lipschitz = objects
-            .iter()
-            .map(|o| o.sdf.lipschitz())
-            .fold(1.0f32, f32::max);
-        let geometry = Geometry {
-            sdfs: objects.iter().map(|o| o.sdf.clone()).collect(),
-            lipschitz,
-        };
+        let geometry = Geometry::new(&objects);
 
         let mut emitters: Vec<Emitter> = lights
             .iter()
@@ -305,6 +415,7 @@ impl Scene {
             sky,
             camera,
             quad_sampling: QuadSampling::default(),
+            marching: Marching::default(),
             geometry,
             emitters,
             emitter_choice,
@@ -319,9 +430,23 @@ impl Scene {
         self.scale
     }
 
-    /// The union of all objects as a distance field.
+    /// The union of all objects as a distance field, evaluated as [`Scene::marching`]
+    /// says (both modes give the same value).
     pub fn distance(&self, p: Vec3) -> f32 {
-        self.geometry.distance(p)
+        match self.marching {
+            Marching::Naive => self.geometry.distance_naive(p),
+            Marching::Fast => self.geometry.distance_culled(p),
+        }
+    }
+
+    /// Marches `ray` through the objects as [`Scene::marching`] says.
+    fn trace(&self, ray: &Ray, params: &TraceParams) -> TraceOutcome {
+        match self.marching {
+            Marching::Naive => sphere_trace(&Naive(&self.geometry), ray, params),
+            Marching::Fast => {
+                sphere_trace_relaxed(&Culled(&self.geometry), ray, params, OVER_RELAXATION)
+            }
+        }
     }
 
     /// The object closest to `p` (after a hit, the one that was hit).
@@ -348,7 +473,7 @@ impl Scene {
         let mut surface = None;
         if !self.objects.is_empty() {
             let p = TraceParams { t_max, ..*params };
-            let outcome = sphere_trace(&self.geometry, ray, &p);
+            let outcome = self.trace(ray, &p);
             counters.record(&outcome);
             if let Some(t) = outcome.hit_t() {
                 let object = self.closest_object(ray.at(t));
@@ -382,7 +507,7 @@ impl Scene {
         if self.objects.is_empty() || t_max <= params.t_min {
             return true;
         }
-        let outcome = sphere_trace(&self.geometry, ray, &TraceParams { t_max, ..*params });
+        let outcome = self.trace(ray, &TraceParams { t_max, ..*params });
         counters.record(&outcome);
         outcome.hit_t().is_none()
     }
@@ -671,6 +796,114 @@ pub(crate) fn ray_quad(ray: &Ray, corner: Vec3, edge_u: Vec3, edge_v: Vec3) -> O
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A union of thin and far shapes, a plane among them, as the integrator sees it.
+    fn crowd() -> Scene {
+        use lueur_sdf_math::Quat;
+        let sdfs = vec![
+            Sdf::plane(Vec3::Y, 1.0),
+            Sdf::torus(1.0, 1e-3).rotate(Quat::from_rotation_x(0.7)),
+            Sdf::cuboid(Vec3::new(1.0, 1.0, 1e-3)).translate(Vec3::new(3.0, 0.0, 0.0)),
+            Sdf::sphere(0.5).translate(Vec3::new(-2.0, 0.5, -1.0)),
+            Sdf::death_star(1.0, 1.0, 0.02).translate(Vec3::new(0.0, 0.0, -40.0)),
+            Sdf::torus(0.5, 0.2).translate(Vec3::new(0.0, 30.0, 0.0)),
+        ];
+        let camera = Camera::new(Vec3::new(0.0, 0.5, 6.0), Vec3::ZERO, Vec3::Y, 40.0).unwrap();
+        Scene::new(
+            sdfs.into_iter()
+                .map(|sdf| Object { sdf, material: 0 })
+                .collect(),
+            vec![Material::Lambertian { albedo: Vec3::ONE }],
+            vec![],
+            None,
+            camera,
+        )
+        .unwrap()
+    }
+
+    /// A deterministic spread of points in a cube of half-side 50.
+    fn points() -> impl Iterator<Item = Vec3> {
+        (0..20_000u32).map(|i| {
+            let f = |k: u32| ((i.wrapping_mul(k) % 10_007) as f32 / 10_007.0 - 0.5) * 100.0;
+            let p = Vec3::new(f(7919), f(104_729), f(1_299_709));
+            // Half of them near the origin, where the shapes are.
+            if i % 2 == 0 { p * 0.05 } else { p }
+        })
+    }
+
+    #[test]
+    fn culling_gives_the_plain_union() {
+        let scene = crowd();
+        for p in points() {
+            let (plain, culled) = (
+                scene.geometry.distance_naive(p),
+                scene.geometry.distance_culled(p),
+            );
+            assert_eq!(plain, culled, "at {p}");
+        }
+    }
+
+    #[test]
+    fn culled_union_is_lipschitz() {
+        let scene = crowd();
+        let l = scene.geometry.lipschitz;
+        let mut previous = Vec3::ZERO;
+        for p in points() {
+            for q in [previous, p + Vec3::splat(1e-3), p * 1.01] {
+                let (fp, fq) = (
+                    scene.geometry.distance_culled(p),
+                    scene.geometry.distance_culled(q),
+                );
+                let tol = 1e-5 * (1.0 + p.length() + q.length());
+                assert!(
+                    (fp - fq).abs() <= l * (p - q).length() + tol,
+                    "|f({p}) - f({q})| = |{fp} - {fq}| > {l} |p - q|"
+                );
+            }
+            previous = p;
+        }
+    }
+
+    #[test]
+    fn fast_marching_finds_the_naive_hits() {
+        let mut naive = crowd();
+        naive.marching = Marching::Naive;
+        let fast = crowd();
+        let params = TraceParams {
+            t_max: 200.0,
+            max_steps: 100_000,
+            eps_abs: 1e-6,
+            eps_rel: 1e-5,
+            ..TraceParams::default()
+        };
+        let (mut naive_steps, mut fast_steps) =
+            (TraceCounters::default(), TraceCounters::default());
+        for (i, p) in points().enumerate() {
+            let origin = Vec3::new(0.0, 0.5, 6.0) + Vec3::Y * (i % 3) as f32;
+            let ray = Ray::new(origin, p * 0.1 - origin);
+            let a = naive.intersect(&ray, &params, &mut naive_steps);
+            let b = fast.intersect(&ray, &params, &mut fast_steps);
+            match (a, b) {
+                (None, None) => {}
+                (
+                    Some(Hit::Surface {
+                        t: ta, object: oa, ..
+                    }),
+                    Some(Hit::Surface {
+                        t: tb, object: ob, ..
+                    }),
+                ) => {
+                    assert_eq!(oa, ob, "ray {ray:?}: objects {oa} and {ob} at {ta}, {tb}");
+                    assert!(
+                        (ta - tb).abs() <= 1e-3 * ta,
+                        "ray {ray:?}: naive {ta}, fast {tb}"
+                    );
+                }
+                _ => panic!("ray {ray:?}: naive {a:?}, fast {b:?}"),
+            }
+        }
+        assert!(fast_steps.steps < naive_steps.steps);
+    }
 
     #[test]
     fn ray_sphere_from_outside_and_inside() {

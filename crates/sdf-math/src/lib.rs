@@ -54,4 +54,6 @@ pub use crate::field::DistanceField;
 pub use crate::normal::{FALLBACK_NORMAL, gradient, normal, normal_central};
 pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
-pub use crate::trace::{TraceOutcome, TraceParams, sphere_trace};
+pub use crate::trace::{
+    OVER_RELAXATION, TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed,
+};

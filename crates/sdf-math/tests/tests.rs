@@ -963,3 +963,201 @@ mod robustness {
         }
     }
 }
+
+/// Over-relaxed tracing (Keinert et al. 2014) against plain Hart tracing as the reference:
+/// on thin shapes and unions, at scales 1e-4..1e4, it never passes a surface that plain
+/// tracing stops at.
+mod relaxed {
+    use super::*;
+    use lueur_sdf_math::{OVER_RELAXATION, sphere_trace_relaxed};
+
+    /// A thin shape of unit size and a point inside it chosen by `(u, v)` in `[0, 1)^2`.
+    fn thin(kind: u8, u: f32, v: f32) -> (Sdf, Vec3) {
+        let tau = std::f32::consts::TAU;
+        match kind {
+            // A ring of radius 1 with a tube of radius 1e-3; the point is on its core.
+            0 => (
+                Sdf::torus(1.0, 1e-3),
+                Vec3::new((tau * u).cos(), 0.0, (tau * u).sin()),
+            ),
+            // A plate 2e-3 thick.
+            1 => (
+                Sdf::cuboid(Vec3::new(1.0, 1.0, 1e-3)),
+                Vec3::new(2.0 * u - 1.0, 2.0 * v - 1.0, 0.0) * 0.999,
+            ),
+            // Three parallel plates 1e-3 thick, 0.1 apart; the point is in the last one.
+            2 => (
+                Sdf::union(
+                    [-0.1f32, 0.0, 0.1]
+                        .map(|z| {
+                            Sdf::cuboid(Vec3::new(1.0, 1.0, 5e-4)).translate(Vec3::new(0.0, 0.0, z))
+                        })
+                        .to_vec(),
+                ),
+                Vec3::new(2.0 * u - 1.0, 2.0 * v - 1.0, 0.0) * 0.999 + Vec3::new(0.0, 0.0, 0.1),
+            ),
+            // The Death Star's rim: a unit sphere bitten by an equal one 0.02 away leaves a
+            // crescent whose thickness falls from 0.02 to 0 at the rim; the point is at
+            // most 85 degrees from the pole, where it is still 1.7e-3 thick.
+            _ => {
+                let theta = (85f32 * u).to_radians();
+                let phi = tau * v;
+                let dir = Vec3::new(
+                    -theta.cos(),
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                );
+                let r = 1.0 - 0.02 * theta.cos() / 2.0;
+                (Sdf::death_star(1.0, 1.0, 0.02), dir * r)
+            }
+        }
+    }
+
+    /// Tracing parameters for a shape of size `scale`, seen from about `3 scale`.
+    fn params(scale: f32) -> TraceParams {
+        TraceParams {
+            t_min: 0.0,
+            t_max: 20.0 * scale,
+            max_steps: 100_000,
+            eps_abs: 1e-6 * scale,
+            eps_rel: 1e-5,
+        }
+    }
+
+    /// Whether the two ends lie on one piece of surface: the field between them never
+    /// rises above a few hit thresholds (it would between two separate surfaces).
+    fn same_surface(sdf: &Sdf, ray: &Ray, a: f32, b: f32, p: &TraceParams) -> bool {
+        let (lo, hi) = (a.min(b), a.max(b));
+        let eps = p.eps_abs.max(p.eps_rel * hi);
+        (0..=64).all(|i| {
+            let t = lo + (hi - lo) * (i as f32 / 64.0);
+            sdf.distance(ray.at(t)) <= 4.0 * eps * sdf.lipschitz()
+        })
+    }
+
+    /// Both tracers agree: both hit on one piece of surface, or both miss.
+    fn agree(sdf: &Sdf, ray: &Ray, p: &TraceParams) -> Result<(), TestCaseError> {
+        let plain = sphere_trace(sdf, ray, p);
+        let relaxed = sphere_trace_relaxed(sdf, ray, p, OVER_RELAXATION);
+        prop_assert!(relaxed.steps() <= p.max_steps);
+        match (plain, relaxed) {
+            (TraceOutcome::GaveUp { .. }, _) => {} // no reference
+            (TraceOutcome::Hit { t: tp, .. }, TraceOutcome::Hit { t: tr, .. }) => {
+                let f = sdf.distance(ray.at(tr));
+                prop_assert!(f < p.eps_abs.max(p.eps_rel * tr), "relaxed hit reads {f}");
+                prop_assert!(
+                    same_surface(sdf, ray, tp, tr, p),
+                    "plain hit at {tp}, relaxed at {tr}: different surfaces ({plain:?}, {relaxed:?})"
+                );
+            }
+            (TraceOutcome::Miss { .. }, TraceOutcome::Miss { .. }) => {}
+            // Running out of steps is slow, not wrong, as long as it stopped short.
+            (TraceOutcome::Hit { t: tp, .. }, TraceOutcome::GaveUp { t: tr, .. }) => {
+                prop_assert!(
+                    tr <= tp * (1.0 + 1e-5),
+                    "gave up at {tr}, past the hit at {tp}"
+                );
+            }
+            _ => prop_assert!(false, "plain {plain:?} but relaxed {relaxed:?}"),
+        }
+        Ok(())
+    }
+
+    proptest! {
+        #![proptest_config(config(512))]
+
+        /// Rays aimed at a point inside a thin shape stop before reaching it, with either
+        /// tracer, and on the same piece of surface.
+        #[test]
+        fn never_skips_thin_shapes(
+            kind in 0u8..4,
+            (u, v) in (0f32..1.0, 0f32..1.0),
+            turn in rotation(),
+            scale in log_uniform(-4.0, 4.0),
+            offset in in_cube(1.0),
+            from in unit(),
+            distance in 1.5f32..6.0,
+        ) {
+            let (shape, inside) = thin(kind, u, v);
+            let centre = offset * scale;
+            let sdf = shape.rotate(turn).scale(scale).translate(centre);
+            let inside = centre + turn * inside * scale;
+            prop_assert!(sdf.distance(inside) < 0.0, "{inside} is not inside");
+            let origin = centre + from * (distance * scale);
+            prop_assume!(sdf.distance(origin) > 0.0);
+            let ray = Ray::new(origin, inside - origin);
+            let p = params(scale);
+            let reach = (inside - origin).length();
+            for outcome in [sphere_trace(&sdf, &ray, &p), sphere_trace_relaxed(&sdf, &ray, &p, OVER_RELAXATION)] {
+                let t = outcome.hit_t();
+                prop_assert!(
+                    t.is_some_and(|t| t <= reach * (1.0 + 1e-5)),
+                    "{outcome:?} passes the inside point at {reach}"
+                );
+            }
+            agree(&sdf, &ray, &p)?;
+        }
+
+        /// Thin shapes seen edge-on: rays in the plane of a plate or a box face, or
+        /// grazing them by less than their thickness.
+        #[test]
+        fn edge_on(
+            kind in 1u8..3,
+            turn in rotation(),
+            scale in log_uniform(-4.0, 4.0),
+            (x, y) in (-1.5f32..1.5, -1.5f32..1.5),
+            lift in -2e-3f32..2e-3,
+            angle in 0f32..std::f32::consts::TAU,
+        ) {
+            let (shape, _) = thin(kind, 0.0, 0.0);
+            let sdf = shape.rotate(turn).scale(scale);
+            // Start outside, 3 units away in the plate's plane, heading through (x, y).
+            let dir = Vec3::new(angle.cos(), angle.sin(), 0.0);
+            let target = Vec3::new(x, y, lift);
+            let origin = target - dir * 3.0;
+            let ray = Ray::new(turn * origin * scale, turn * dir);
+            prop_assume!(sdf.distance(ray.origin) > 0.0);
+            agree(&sdf, &ray, &params(scale))?;
+        }
+
+        /// Random rays at random unions (the shapes an integrator traces).
+        #[test]
+        fn unions(
+            children in children(),
+            thin_kind in 0u8..4,
+            turn in rotation(),
+            from in unit(),
+            aims in prop::collection::vec(in_cube(1.0), 8),
+        ) {
+            let mut children = children;
+            children.push(thin(thin_kind, 0.0, 0.0).0.rotate(turn));
+            let sdf = Sdf::union(children);
+            let (c, r) = sdf.bounding_sphere().unwrap_or((Vec3::ZERO, 1.0));
+            let r = r.max(1e-3);
+            let origin = c + from * (3.0 * r);
+            prop_assume!(sdf.distance(origin) > 0.0);
+            for aim in aims {
+                let ray = Ray::new(origin, c + aim * r - origin);
+                agree(&sdf, &ray, &params(r))?;
+            }
+        }
+    }
+
+    /// Over-relaxation earns its place: on rays that pass near surfaces (where plain
+    /// tracing crawls), it spends fewer evaluations in total. A step count, not a timing.
+    #[test]
+    fn takes_fewer_steps_on_grazing_rays() {
+        let sdf = Sdf::torus(1.0, 0.25).rotate(Quat::from_rotation_x(0.4));
+        let p = params(1.0);
+        let (mut plain, mut relaxed) = (0u64, 0u64);
+        for i in 0..1000 {
+            let a = i as f32 * 0.618_034 * std::f32::consts::TAU;
+            let origin = Vec3::new(4.0 * a.cos(), 0.3 * a.sin(), 4.0 * a.sin());
+            let aim = Vec3::new(0.0, (i % 7) as f32 * 0.1 - 0.3, 0.0);
+            let ray = Ray::new(origin, aim - origin);
+            plain += sphere_trace(&sdf, &ray, &p).steps() as u64;
+            relaxed += sphere_trace_relaxed(&sdf, &ray, &p, OVER_RELAXATION).steps() as u64;
+        }
+        assert!(relaxed < plain, "relaxed {relaxed} >= plain {plain} steps");
+    }
+}

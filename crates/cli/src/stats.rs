@@ -1,0 +1,31 @@
+//! `lueur render --stats`: what a render measured about itself, as a table.
+
+use lueur_integrator::RenderOutput;
+
+/// Prints the statistics of a finished render to standard output.
+pub fn print_stats(out: &RenderOutput) {
+    let s = &out.stats;
+    let secs = s.elapsed.as_secs_f64().max(1e-9);
+    println!(
+        "samples          {:>14}  ({:.3} M/s)",
+        s.samples,
+        s.samples as f64 / secs / 1e6
+    );
+    println!("dropped (NaN/Inf){:>14}", s.dropped_samples);
+    for (name, c) in [
+        ("camera", &s.rays.camera),
+        ("bounce", &s.rays.bounce),
+        ("shadow", &s.rays.shadow),
+    ] {
+        let rays = c.rays.max(1) as f64;
+        println!(
+            "{name:<7} rays {:>12}  ({:.3} M/s)  steps/ray {:>6.1}  hit {:>5.1}%  miss {:>5.1}%  gave up {:>5.2}%",
+            c.rays,
+            c.rays as f64 / secs / 1e6,
+            c.steps as f64 / rays,
+            100.0 * c.hits as f64 / rays,
+            100.0 * c.misses as f64 / rays,
+            100.0 * c.gave_up as f64 / rays,
+        );
+    }
+}
