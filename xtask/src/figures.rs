@@ -1,50 +1,238 @@
-//! `cargo xtask figures`: the report's images, regenerated.
+//! `cargo xtask figures`: the report's images, regenerated deterministically
+//! (fixed seeds) into `docs/figures/`, with `docs/FIGURES.md` describing
+//! each one and the command and scene that made it.
 
-use anyhow::Result;
-use lueur::integrator::{RenderSettings, Strategy};
+use std::fmt::Write as _;
+use std::path::Path;
 
-use crate::{load_scene, project_root, render_with_bar, save_png};
+use anyhow::{Context, Result};
+use image::RgbImage;
+use lueur::integrator::{Film, RenderSettings, Strategy};
+
+use crate::compose::{color_bar, error_map, grid, stack};
+use crate::reference::{flatten, reference};
+use crate::{load_scene, project_root, render_with_bar};
 
 /// The shipped scenes, in the order of the report's figures.
 pub const SCENES: [&str; 3] = ["death-star", "donut-mirrors", "cornell-spheres"];
 
+/// Image sizes and sample counts of one run of the command.
+struct Plan {
+    showcase_size: u32,
+    showcase_spp: u32,
+    compare_size: u32,
+    compare_spp: [u32; 2],
+    reference_spp: u32,
+}
+
+const FULL: Plan = Plan {
+    showcase_size: 256,
+    showcase_spp: 256,
+    compare_size: 128,
+    compare_spp: [4, 128],
+    reference_spp: 4096,
+};
+
+const QUICK: Plan = Plan {
+    showcase_size: 64,
+    showcase_spp: 8,
+    compare_size: 48,
+    compare_spp: [4, 32],
+    reference_spp: 256,
+};
+
+/// Relative error shown as the top of the colour scale of error maps.
+const ERROR_FULL_SCALE: f64 = 1.0;
+/// Added to the reference in the relative error's denominator, so that
+/// black pixels do not divide by zero (the usual relMSE guard).
+const ERROR_EPSILON: f64 = 0.01;
+
 pub fn run(quick: bool) -> Result<()> {
+    let plan = if quick { QUICK } else { FULL };
     let dir = project_root().join("docs").join("figures");
-    std::fs::create_dir_all(&dir)?;
-    let shrink = |s: &mut RenderSettings| {
-        if quick {
-            s.width /= 4;
-            s.height /= 4;
-            s.spp = s.spp.min(8);
-        }
-    };
-    for name in SCENES {
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut md = String::new();
+    let flag = if quick { " --quick" } else { "" };
+    writeln!(
+        md,
+        "# Figures\n\nEvery image here is made by `cargo xtask figures{flag}` from the scene files in \
+         `scenes/`, with fixed seeds, so running it again gives the same files. Error maps show the \
+         per-pixel relative error |x - ref| / (ref + {ERROR_EPSILON}), averaged over RGB, against a \
+         `mis` reference at {} spp; the colour scale runs from 0 (dark) to {ERROR_FULL_SCALE} and above \
+         (yellow).\n",
+        plan.reference_spp
+    )?;
+
+    // Figures 1 and 2 (and the Cornell example): the shipped scenes with
+    // the default strategy at enough samples to show the scene rather than
+    // the noise; the comparisons below show the noise.
+    for (i, name) in SCENES.iter().enumerate() {
         let file = load_scene(name)?;
-        let mut settings = file.settings.clone();
-        shrink(&mut settings);
+        let settings = RenderSettings {
+            width: plan.showcase_size,
+            height: plan.showcase_size,
+            strategy: Strategy::Mis,
+            spp: plan.showcase_spp,
+            ..file.settings.clone()
+        };
         let film = render_with_bar(&file.scene, &settings, name)?;
-        save_png(&film, &dir.join(format!("{name}.png")))?;
+        save(&to_rgb(&film), &dir.join(format!("{name}.png")))?;
+        writeln!(
+            md,
+            "## {}\n\n![]({name}.png)\n\n`scenes/{name}.toml`, {}x{}, `mis`, {} spp.\n",
+            match i {
+                0 => "Figure 1: the Death Star under a light at infinity",
+                1 => "Figure 2: the donut between two mirror spheres",
+                _ => "The Cornell box with a diffuse and a mirror sphere",
+            },
+            plan.showcase_size,
+            plan.showcase_size,
+            plan.showcase_spp
+        )?;
     }
-    // Figures 3 to 6: each strategy at 4 and 128 spp on the donut.
-    let file = load_scene("donut-mirrors")?;
+
+    // Figures 3 to 7: each strategy at two sample counts on the donut, with
+    // error maps against a reference.
+    let scene = "donut-mirrors";
+    let file = load_scene(scene)?;
+    let size = plan.compare_size;
+    let reference = reference(scene, &file, size, plan.reference_spp)?;
+    let bar = color_bar(size, "0", &format!(">={ERROR_FULL_SCALE}"));
+    let mut renders: Vec<(Strategy, u32, RgbImage, RgbImage, f64)> = Vec::new();
     for strategy in [
         Strategy::Uniform,
         Strategy::Light,
         Strategy::Mixture,
         Strategy::Mis,
     ] {
-        for spp in [4, 128] {
-            let mut settings = RenderSettings {
+        for spp in plan.compare_spp {
+            let settings = RenderSettings {
+                width: size,
+                height: size,
                 spp,
                 strategy,
                 ..file.settings.clone()
             };
-            shrink(&mut settings);
             let label = format!("donut {strategy} {spp} spp");
             let film = render_with_bar(&file.scene, &settings, &label)?;
-            save_png(&film, &dir.join(format!("donut-{strategy}-{spp}spp.png")))?;
+            let img = to_rgb(&film);
+            save(&img, &dir.join(format!("donut-{strategy}-{spp}spp.png")))?;
+            let (errors, mean_error) = relative_errors(&film, &reference.mean);
+            let map = error_map(size, size, &errors, ERROR_FULL_SCALE);
+            renders.push((strategy, spp, img, map, mean_error));
         }
     }
-    eprintln!("figures written to {}", dir.display());
+    let cell = |s: Strategy, spp: u32| {
+        renders
+            .iter()
+            .find(|r| r.0 == s && r.1 == spp)
+            .expect("rendered above")
+    };
+    let [low, high] = plan.compare_spp;
+    for (number, strategy, what) in [
+        (3, Strategy::Uniform, "uniform hemisphere sampling"),
+        (
+            4,
+            Strategy::Light,
+            "light sampling (biased: no light through the mirrors)",
+        ),
+        (5, Strategy::Mixture, "the mixture of both (one-sample MIS)"),
+    ] {
+        let (a, b) = (cell(strategy, low), cell(strategy, high));
+        let fig = stack(&[
+            grid(
+                Some(&format!("Fig. {number}: {strategy}")),
+                &[
+                    vec![
+                        (format!("{low} spp"), a.2.clone()),
+                        (format!("{high} spp"), b.2.clone()),
+                    ],
+                    vec![
+                        (format!("err {:.3}", a.4), a.3.clone()),
+                        (format!("err {:.3}", b.4), b.3.clone()),
+                    ],
+                ],
+            ),
+            bar.clone(),
+        ]);
+        let file_name = format!("fig{number}-{strategy}.png");
+        save(&fig, &dir.join(&file_name))?;
+        writeln!(
+            md,
+            "## Figure {number}: {what}\n\n![]({file_name})\n\n`scenes/{scene}.toml` at {size}x{size}, \
+             `--strategy {strategy}`, {low} and {high} spp; below each image its error map and mean \
+             relative error.\n"
+        )?;
+    }
+    for (number, spp) in [(6, high), (7, low)] {
+        let strategies = [
+            Strategy::Uniform,
+            Strategy::Mixture,
+            Strategy::Light,
+            Strategy::Mis,
+        ];
+        let images = strategies
+            .iter()
+            .map(|&s| (s.to_string(), cell(s, spp).2.clone()))
+            .collect();
+        let maps = strategies
+            .iter()
+            .map(|&s| (format!("err {:.3}", cell(s, spp).4), cell(s, spp).3.clone()))
+            .collect();
+        let fig = stack(&[
+            grid(
+                Some(&format!("Fig. {number}: {spp} spp each")),
+                &[images, maps],
+            ),
+            bar.clone(),
+        ]);
+        let file_name = format!("fig{number}-strategies-{spp}spp.png");
+        save(&fig, &dir.join(&file_name))?;
+        writeln!(
+            md,
+            "## Figure {number}: uniform, mixture, light and mis at {spp} spp\n\n![]({file_name})\n\n\
+             The report's side-by-side comparison at equal samples, with `mis` added, and the error maps. \
+             `light` looks smoothest but is wrong where light arrives through the mirrors: its error \
+             does not fall with more samples.\n"
+        )?;
+    }
+
+    let md_path = project_root().join("docs").join("FIGURES.md");
+    std::fs::write(&md_path, md).with_context(|| format!("writing {}", md_path.display()))?;
+    eprintln!(
+        "figures written to {} and {}",
+        dir.display(),
+        md_path.display()
+    );
     Ok(())
+}
+
+/// Per-pixel relative error against the reference (RGB averaged), and its
+/// mean over the image.
+fn relative_errors(film: &Film, reference: &[f32]) -> (Vec<f64>, f64) {
+    let img = flatten(&film.mean_image());
+    let errors: Vec<f64> = img
+        .chunks_exact(3)
+        .zip(reference.chunks_exact(3))
+        .map(|(x, r)| {
+            x.iter()
+                .zip(r)
+                .map(|(&x, &r)| {
+                    (f64::from(x) - f64::from(r)).abs() / (f64::from(r) + ERROR_EPSILON)
+                })
+                .sum::<f64>()
+                / 3.0
+        })
+        .collect();
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+    (errors, mean)
+}
+
+fn to_rgb(film: &Film) -> RgbImage {
+    RgbImage::from_raw(film.width(), film.height(), film.srgb8(0.0)).expect("film size matches")
+}
+
+fn save(img: &RgbImage, path: &Path) -> Result<()> {
+    img.save(path)
+        .with_context(|| format!("writing {}", path.display()))
 }

@@ -1,7 +1,10 @@
 //! `cargo xtask`: lueur's lab bench. Each subcommand regenerates something
 //! under `docs/` from the scene files, deterministically (fixed seeds).
 
+mod compose;
 mod figures;
+mod reference;
+mod tradeoff;
 mod variance;
 
 use std::path::{Path, PathBuf};
@@ -33,12 +36,20 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Measure error against time for each strategy and sampler, and what
+    /// the marching knobs and max_depth cost and buy; writes docs/TRADEOFF.md.
+    Tradeoff {
+        /// Smaller images and fewer samples, for CI.
+        #[arg(long)]
+        quick: bool,
+    },
 }
 
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Figures { quick } => figures::run(quick),
         Command::Variance { quick } => variance::run(quick),
+        Command::Tradeoff { quick } => tradeoff::run(quick),
     }
 }
 
@@ -74,12 +85,4 @@ pub fn render_with_bar(scene: &Scene, settings: &RenderSettings, label: &str) ->
         out.stats.dropped_samples
     );
     Ok(out.film)
-}
-
-/// Writes a film as an sRGB PNG.
-pub fn save_png(film: &Film, path: &Path) -> Result<()> {
-    let img = image::RgbImage::from_raw(film.width(), film.height(), film.srgb8(0.0))
-        .context("film size")?;
-    img.save(path)
-        .with_context(|| format!("writing {}", path.display()))
 }
