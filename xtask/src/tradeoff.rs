@@ -35,6 +35,8 @@ struct Plan {
     max_spp: u32,
     reference_spp: u32,
     knob_spp: u32,
+    /// Renders per knob setting; the time reported is their median.
+    repeats: usize,
     budgets: &'static [f64],
 }
 
@@ -43,6 +45,7 @@ const FULL: Plan = Plan {
     max_spp: 1024,
     reference_spp: 8192,
     knob_spp: 64,
+    repeats: 3,
     budgets: &[0.1, 1.0, 4.0],
 };
 
@@ -51,6 +54,7 @@ const QUICK: Plan = Plan {
     max_spp: 32,
     reference_spp: 512,
     knob_spp: 8,
+    repeats: 1,
     budgets: &[0.01, 0.05],
 };
 
@@ -183,24 +187,28 @@ pub fn run(quick: bool) -> Result<()> {
         s.max_steps = 2048;
         s.max_depth = file.settings.max_depth;
     });
-    let baseline = render_quiet(&file, &baseline_settings)?;
+    let baseline = render_median(&file, &baseline_settings, plan.repeats)?;
     writeln!(
         md,
         "## Marching knobs\n\nEach row changes one knob from the tight baseline (`pixel_epsilon` 0.0625, \
-         `epsilon` 1e-5, `max_steps` 2048) at {} spp, `mis`, same seed. \"Bias RMS\" is the RMS difference \
-         to the baseline image: with common random numbers it is the error the knob introduces. \
+         `epsilon` 1e-5, `max_steps` 2048) at {} spp, `mis`, same seed. \"Image mean shift\" is the change of the \
+         image's mean radiance with its standard error (as if the two renders were independent; common random \
+         numbers make the true noise smaller); \"RMS diff / noise\" compares the per-pixel difference with \
+         the noise of two independent renders: near or below 1 the knob's bias is lost in the noise, well \
+         above 1 it shows. \
          \"Steps/ray\" counts scene evaluations per camera ray; \"gave up\" is the share of camera rays \
          that hit the step cap.\n",
         plan.knob_spp
     )?;
     writeln!(
         md,
-        "| knob | value | time (s) | vs baseline time | steps/camera ray | steps/bounce ray | gave up | bias RMS |\n|---|---|---|---|---|---|---|---|"
+        "| knob | value | time (s) | vs baseline time | steps/camera ray | steps/bounce ray | gave up | image mean shift | RMS diff / noise |\n|---|---|---|---|---|---|---|---|---|"
     )?;
     let base_row = knob_row(&baseline, &baseline);
     writeln!(md, "| baseline | — | {} |", base_row)?;
-    let mut knob_csv =
-        String::from("knob,value,seconds,camera_steps,bounce_steps,gave_up,bias_rms\n");
+    let mut knob_csv = String::from(
+        "knob,value,seconds,time_ratio,camera_steps,bounce_steps,gave_up,mean_shift,mean_shift_se,rms_over_noise\n",
+    );
     let knobs: Vec<(&str, Vec<f32>)> = vec![
         ("pixel_epsilon", vec![0.25, 1.0, 4.0, 16.0]),
         ("epsilon", vec![1e-4, 1e-3, 1e-2]),
@@ -209,20 +217,21 @@ pub fn run(quick: bool) -> Result<()> {
     ];
     for (knob, values) in knobs {
         for v in values {
-            let s = RenderSettings {
-                ..baseline_settings.clone()
-            };
-            let mut s = s;
+            let mut s = baseline_settings.clone();
             match knob {
                 "pixel_epsilon" => s.pixel_epsilon = v,
                 "epsilon" => s.epsilon_rel = v,
                 "max_steps" => s.max_steps = v as u32,
                 _ => s.max_depth = v as u32,
             }
-            let out = render_quiet(&file, &s)?;
+            let out = render_median(&file, &s, plan.repeats)?;
             let row = knob_row(&out, &baseline);
             writeln!(md, "| {knob} | {v} | {row} |")?;
-            writeln!(knob_csv, "{knob},{v},{}", row.replace(" | ", ","))?;
+            writeln!(
+                knob_csv,
+                "{knob},{v},{}",
+                row.replace(" | ", ",").replace(" ± ", ",")
+            )?;
         }
     }
     std::fs::write(cache_dir()?.join("tradeoff-knobs.csv"), knob_csv)?;
@@ -267,28 +276,66 @@ fn render_quiet(file: &SceneFile, settings: &RenderSettings) -> Result<RenderOut
     Ok(out)
 }
 
-/// The table cells of one knob setting against the baseline.
+/// Renders `repeats` times (identical images: same seed) and keeps the
+/// median time, since one timing on a shared machine is noise.
+fn render_median(
+    file: &SceneFile,
+    settings: &RenderSettings,
+    repeats: usize,
+) -> Result<RenderOutput> {
+    let mut times = Vec::with_capacity(repeats);
+    let mut last = None;
+    for _ in 0..repeats.max(1) {
+        let out = render_quiet(file, settings)?;
+        times.push(out.stats.elapsed);
+        last = Some(out);
+    }
+    times.sort();
+    let mut out = last.expect("rendered at least once");
+    out.stats.elapsed = times[times.len() / 2];
+    Ok(out)
+}
+
+/// The table cells of one knob setting against the baseline: cost, and
+/// the shift of the image it causes. Common random numbers make the two
+/// renders' noise correlated, but paths that diverge (a hit point moved by
+/// an epsilon changes what a bounce finds) decorrelate, so the shift is
+/// stated against the noise of two independent renders: a shift within a
+/// few of those standard errors is not a measurable bias.
 fn knob_row(out: &RenderOutput, baseline: &RenderOutput) -> String {
     let a = flatten(&out.film.mean_image());
     let b = flatten(&baseline.film.mean_image());
+    let n = a.len() as f64;
     let rms = (a
         .iter()
         .zip(&b)
         .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
         .sum::<f64>()
-        / a.len() as f64)
+        / n)
         .sqrt();
+    let noise_rms = (flatten(&out.film.variance_image())
+        .iter()
+        .chain(&flatten(&baseline.film.variance_image()))
+        .map(|&v| f64::from(v))
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    let (ma, sa) = out.film.image_mean();
+    let (mb, sb) = baseline.film.image_mean();
     let secs = out.stats.elapsed.as_secs_f64();
     let base = baseline.stats.elapsed.as_secs_f64();
     let cam = &out.stats.rays.camera;
     let bounce = &out.stats.rays.bounce;
     let per = |steps: u64, rays: u64| steps as f64 / rays.max(1) as f64;
     format!(
-        "{secs:.3} | {:.2}x | {:.1} | {:.1} | {:.2}% | {rms:.2e}",
+        "{secs:.3} | {:.2}x | {:.1} | {:.1} | {:.2}% | {:+.2e} ± {:.1e} | {:.2}",
         secs / base.max(1e-9),
         per(cam.steps, cam.rays),
         per(bounce.steps, bounce.rays),
         100.0 * cam.gave_up as f64 / cam.rays.max(1) as f64,
+        ma - mb,
+        (sa * sa + sb * sb).sqrt(),
+        rms / noise_rms.max(1e-30),
     )
 }
 
