@@ -8,8 +8,9 @@ use rand_pcg::Pcg32;
 use rand_pcg::rand_core::Rng;
 
 use crate::pointsets::{
-    HALTON_MAX_DIMENSIONS, SOBOL_MAX_DIMENSIONS, cmj, halton_base, hash2, hash3,
-    nested_uniform_scramble, owen_scrambled_radical_inverse, permute, radical_inverse, sobol_u32,
+    HALTON_MAX_DIMENSIONS, PMJ02_TABLE_LEN, PMJ02_TABLES, SOBOL_MAX_DIMENSIONS, cmj, halton_base,
+    hash2, hash3, nested_uniform_scramble, owen_scrambled_radical_inverse, permute,
+    pmj02_table_point, radical_inverse, sobol_u32,
 };
 
 /// Which point set a [`Sampler`] draws from. An enum, dispatched by `match`,
@@ -71,6 +72,15 @@ pub enum SamplerKind {
     /// sequence for 1D requests, with a Cranley–Patterson rotation per
     /// (pixel, dimension).
     R2,
+    /// Progressive multi-jittered (0, 2) sequences (Christensen, Kensler and
+    /// Kilpatrick 2018): each request reads one of a few shared pmj02 tables
+    /// at the pixel's sample index, chosen and randomized by a digital (XOR)
+    /// shift per (pixel, dimension), which keeps every power-of-two prefix
+    /// a (0, m, 2)-net, like pbrt-v4's `PMJ02BNSampler` (without its blue-
+    /// noise pixel ordering). 1D requests take the x coordinate, a
+    /// stratified (0, 1)-sequence. Tables hold 4096 samples; past them (or
+    /// past `spp`), a new independent block starts.
+    Pmj02,
 }
 
 impl SamplerKind {
@@ -87,6 +97,7 @@ impl SamplerKind {
         SamplerKind::SobolOwen,
         SamplerKind::ZSobol,
         SamplerKind::R2,
+        SamplerKind::Pmj02,
     ];
 
     /// The lowercase name used on command lines and in scene files.
@@ -103,6 +114,7 @@ impl SamplerKind {
             SamplerKind::SobolOwen => "sobol-owen",
             SamplerKind::ZSobol => "zsobol",
             SamplerKind::R2 => "r2",
+            SamplerKind::Pmj02 => "pmj02",
         }
     }
 
@@ -400,6 +412,7 @@ impl Sampler {
                 let shift = self.sequence_hash(self.dimension);
                 fraction64_to_f32(shift.wrapping_add(u64::from(self.index).wrapping_mul(GOLDEN_1D)))
             }
+            SamplerKind::Pmj02 => fraction_to_f32(self.pmj02()[0]),
         }
     }
 
@@ -449,7 +462,26 @@ impl Sampler {
                     fraction64_to_f32(hash2(shift, 1).wrapping_add(i.wrapping_mul(ay))),
                 )
             }
+            SamplerKind::Pmj02 => {
+                let [x, y] = self.pmj02();
+                Vec2::new(fraction_to_f32(x), fraction_to_f32(y))
+            }
         }
+    }
+
+    /// The current sample of a pmj02 table: the index within the pixel's
+    /// pattern of `spp` selects the point, and the pattern block (and, past
+    /// the table's length, the table block) joins the hash that picks the
+    /// table and its XOR shift, so every block is an independent
+    /// randomization.
+    #[inline]
+    fn pmj02(&self) -> [u32; 2] {
+        let j = self.index_in_pattern() as usize;
+        let h = hash2(self.request_hash(), (j / PMJ02_TABLE_LEN) as u64);
+        let table = (h % PMJ02_TABLES as u64) as usize;
+        let [x, y] = pmj02_table_point(table, j % PMJ02_TABLE_LEN);
+        let shift = hash2(h, 0x0078_6f72);
+        [x ^ shift as u32, y ^ (shift >> 32) as u32]
     }
 
     /// The first `N` (1 or 2) Sobol' dimensions at a shuffled index,
@@ -531,7 +563,8 @@ mod tests {
             Some(SamplerKind::Independent)
         );
         assert_eq!(SamplerKind::from_name("ZSOBOL"), Some(SamplerKind::ZSobol));
-        assert_eq!(SamplerKind::from_name("pmj02"), None);
+        assert_eq!(SamplerKind::from_name("pmj02"), Some(SamplerKind::Pmj02));
+        assert_eq!(SamplerKind::from_name("pmj02bn"), None);
         assert_eq!(SamplerKind::default(), SamplerKind::Independent);
     }
 
