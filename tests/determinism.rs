@@ -36,3 +36,74 @@ fn the_seed_changes_the_image_and_only_the_seed() {
     assert!(a == again);
     assert!(a != b, "a different seed must give different samples");
 }
+
+/// A progressive render (passes of 1, 1, 2, 4 spp, as the CLI runs them)
+/// ends bit-identical to one pass of the same total, for every sampler: each
+/// pixel adds its samples in index order whatever the passes.
+#[test]
+fn passes_add_up_to_the_single_pass_image_bit_for_bit() {
+    use std::sync::atomic::AtomicBool;
+
+    use lueur::integrator::{Film, render_pass};
+    use lueur::sampling::SamplerKind;
+
+    let file = shipped("donut-mirrors");
+    for &sampler in SamplerKind::ALL {
+        let mut settings = file.settings.clone();
+        (
+            settings.width,
+            settings.height,
+            settings.spp,
+            settings.sampler,
+        ) = (20, 18, 8, sampler);
+        let whole = run_with_threads(&file.scene, &settings, 2);
+        let mut film = Film::new(settings.width, settings.height);
+        let never = AtomicBool::new(false);
+        for until in [1, 2, 4, 8] {
+            render_pass(&file.scene, &settings, &mut film, until, &never, &|_| {})
+                .unwrap()
+                .expect("not cancelled");
+            assert_eq!(film.spp(), until);
+        }
+        assert!(film == whole, "{sampler}: passes differ from one pass");
+    }
+}
+
+/// A cancelled pass leaves the film exactly as it was.
+#[test]
+fn a_cancelled_pass_changes_nothing() {
+    use std::sync::atomic::AtomicBool;
+
+    use lueur::integrator::{Film, render_pass};
+
+    let file = shipped("cornell-spheres");
+    let mut settings = file.settings.clone();
+    (settings.width, settings.height, settings.spp) = (16, 16, 4);
+    let mut film = Film::new(16, 16);
+    render_pass(
+        &file.scene,
+        &settings,
+        &mut film,
+        2,
+        &AtomicBool::new(false),
+        &|_| {},
+    )
+    .unwrap()
+    .unwrap();
+    let before = film.clone();
+    let cancelled = render_pass(
+        &file.scene,
+        &settings,
+        &mut film,
+        4,
+        &AtomicBool::new(true),
+        &|_| {},
+    )
+    .unwrap();
+    assert!(cancelled.is_none());
+    assert!(film == before && film.spp() == 2);
+    // A pass that adds nothing, or overshoots the render's spp, is refused.
+    let never = AtomicBool::new(false);
+    assert!(render_pass(&file.scene, &settings, &mut film, 2, &never, &|_| {}).is_err());
+    assert!(render_pass(&file.scene, &settings, &mut film, 5, &never, &|_| {}).is_err());
+}

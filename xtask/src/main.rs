@@ -71,7 +71,9 @@ pub fn load_scene(name: &str) -> Result<SceneFile> {
 
 /// Renders with a progress bar labelled `label`.
 pub fn render_with_bar(scene: &Scene, settings: &RenderSettings, label: &str) -> Result<Film> {
-    let bar = indicatif::ProgressBar::new(settings.width as u64 * settings.height as u64);
+    let bar = indicatif::ProgressBar::new(
+        u64::from(settings.width) * u64::from(settings.height) * u64::from(settings.spp),
+    );
     bar.set_style(
         indicatif::ProgressStyle::with_template("{msg:>32} {wide_bar} {percent:>3}% ETA {eta}")
             .expect("valid template"),

@@ -3,6 +3,8 @@
 //! every decision about light lives in `lueur-integrator`.
 
 mod output;
+mod points;
+mod progressive;
 mod stats;
 
 use std::path::{Path, PathBuf};
@@ -11,7 +13,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use lueur_integrator::{Marching, RenderOutput, RenderSettings, Strategy, render};
+use lueur_integrator::{Marching, RenderOutput, RenderSettings, Strategy};
 use lueur_sampling::SamplerKind;
 use lueur_scene::{SceneFileError, parse_scene};
 
@@ -35,6 +37,9 @@ enum Command {
     /// Render a scene file to an image (.png: 8-bit sRGB; .exr: linear float
     /// RGB plus the per-pixel variance of the mean).
     Render(RenderArgs),
+    /// Generate a point set (CSV or PNG plot) and measure it: discrepancies
+    /// and integration error.
+    Points(points::PointsArgs),
 }
 
 #[derive(Parser)]
@@ -78,6 +83,14 @@ struct RenderArgs {
     /// reference that speed-ups are measured against.
     #[arg(long)]
     naive: bool,
+    /// Stop at this wall-clock budget in seconds, after the last whole pass
+    /// that fits (passes of 1, 1, 2, 4, ... spp; the first always runs).
+    #[arg(long, value_name = "SECONDS")]
+    time: Option<f64>,
+    /// Stop once the image's relative standard error (RMS pixel standard
+    /// error over mean radiance) is at most this, e.g. 0.01.
+    #[arg(long, value_name = "E")]
+    target_error: Option<f64>,
 }
 
 fn parse_strategy(s: &str) -> Result<Strategy, String> {
@@ -92,6 +105,39 @@ fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
         let all: Vec<_> = SamplerKind::ALL.iter().map(|s| s.name()).collect();
         format!("unknown sampler `{s}`; expected one of {}", all.join(", "))
     })
+}
+
+/// The render was stopped by a signal; what was complete has been written.
+#[derive(Debug)]
+struct Interrupted(u32);
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.0 == 0 {
+            write!(
+                f,
+                "interrupted before the first pass completed; nothing written"
+            )
+        } else {
+            write!(
+                f,
+                "interrupted: wrote the {} spp completed before the signal",
+                self.0
+            )
+        }
+    }
+}
+
+impl std::error::Error for Interrupted {}
+
+/// `Some(v)` if `v` is positive and finite, a usage error otherwise.
+fn positive(v: Option<f64>, flag: &str) -> Result<Option<f64>> {
+    match v {
+        Some(x) if !(x > 0.0 && x.is_finite()) => {
+            Err(BadInput(format!("{flag} must be positive and finite, got {x}")).into())
+        }
+        _ => Ok(v),
+    }
 }
 
 /// An error the user caused and can fix; exits with status 2.
@@ -110,6 +156,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => run_render(args),
+        Command::Points(args) => points::run_points(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -122,6 +169,9 @@ fn main() -> ExitCode {
                 return ExitCode::from(EXIT_BAD_INPUT);
             }
             eprintln!("error: {e:#}");
+            if e.downcast_ref::<Interrupted>().is_some() {
+                return ExitCode::from(progressive::EXIT_INTERRUPTED);
+            }
             if e.downcast_ref::<BadInput>().is_some() {
                 ExitCode::from(EXIT_BAD_INPUT)
             } else {
@@ -147,8 +197,15 @@ fn run_render(args: RenderArgs) -> Result<()> {
     };
     let format = output::Format::from_path(&out).map_err(|e| BadInput(e.to_string()))?;
 
-    let pixels = settings.width as u64 * settings.height as u64;
-    let bar = ProgressBar::new(pixels);
+    let limits = progressive::Limits {
+        time: positive(args.time, "--time")?,
+        target_error: positive(args.target_error, "--target-error")?,
+    };
+    progressive::install_signal_handler()?;
+
+    let bar = ProgressBar::new(
+        u64::from(settings.width) * u64::from(settings.height) * u64::from(settings.spp),
+    );
     bar.set_style(
         ProgressStyle::with_template(
             "{spinner} [{elapsed_precise}] {wide_bar} {percent}% ETA {eta}",
@@ -156,17 +213,23 @@ fn run_render(args: RenderArgs) -> Result<()> {
         .expect("the template is valid"),
     );
     let progress = |n: u64| bar.inc(n);
-    let output: RenderOutput = match args.threads {
+    let run = || progressive::render(&scene, &settings, limits, &progress);
+    let (output, stop) = match args.threads {
         Some(0) => return Err(BadInput("--threads must be at least 1".into()).into()),
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
             .context("cannot start the worker threads")?
-            .install(|| render(&scene, &settings, &progress)),
-        None => render(&scene, &settings, &progress),
+            .install(run),
+        None => run(),
     }
     .map_err(|e| BadInput(e.to_string()))?;
     bar.finish_and_clear();
+    let output: RenderOutput = output;
+    if output.film.spp() == 0 {
+        // Interrupted during the first pass: nothing whole to write.
+        return Err(Interrupted(0).into());
+    }
 
     output::write_image(&out, format, &output.film, args.exposure)
         .with_context(|| format!("cannot write {}", out.display()))?;
@@ -177,7 +240,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
         "rendered {}x{} at {} spp ({}, {}) in {:.2} s, {:.2} M samples/s -> {}",
         settings.width,
         settings.height,
-        settings.spp,
+        output.film.spp(),
         settings.strategy,
         settings.sampler.name(),
         secs,
@@ -192,6 +255,21 @@ fn run_render(args: RenderArgs) -> Result<()> {
     }
     if args.stats {
         stats::print_stats(&output);
+    }
+    match stop {
+        progressive::Stop::Complete => {}
+        progressive::Stop::TimeBudget => eprintln!(
+            "time budget of {} s reached: stopped at {} of {} spp",
+            args.time.unwrap_or_default(),
+            output.film.spp(),
+            settings.spp
+        ),
+        progressive::Stop::TargetError(e) => eprintln!(
+            "target error reached: relative error {e:.4} at {} of {} spp",
+            output.film.spp(),
+            settings.spp
+        ),
+        progressive::Stop::Interrupted => return Err(Interrupted(output.film.spp()).into()),
     }
     Ok(())
 }

@@ -156,3 +156,210 @@ fn an_unwritable_output_fails_cleanly() {
     assert!(stderr(&o).contains("cannot write"));
     assert!(files_in(dir.path()).is_empty());
 }
+
+#[test]
+fn points_csv_has_n_lines_of_d_coordinates_in_the_unit_cube() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = lueur(
+        &[
+            "points",
+            "--sampler",
+            "sobol-owen",
+            "-n",
+            "1024",
+            "-d",
+            "3",
+            "--seed",
+            "3",
+            "--out",
+            "pts.csv",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(dir.path().join("pts.csv")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 1024);
+    for line in lines {
+        let values: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+        assert_eq!(values.len(), 3, "{line}");
+        assert!(values.iter().all(|v| (0.0..1.0).contains(v)), "{line}");
+    }
+    assert_eq!(files_in(dir.path()).len(), 1, "no temporary file is left");
+}
+
+#[test]
+fn points_png_is_a_512_square_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = lueur(
+        &[
+            "points",
+            "--sampler",
+            "pmj02",
+            "-n",
+            "256",
+            "--out",
+            "pts.png",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(dir.path().join("pts.png")).unwrap().to_luma8();
+    assert_eq!(img.dimensions(), (512, 512));
+    let dark = img.pixels().filter(|p| p.0[0] == 0).count();
+    // 256 dots of at most 3x3 pixels, some overlapping or clipped.
+    assert!((256..=256 * 9).contains(&dark), "{dark} dark pixels");
+}
+
+#[test]
+fn points_metrics_prints_discrepancies_and_integration_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = lueur(
+        &["points", "--sampler", "stratified", "-n", "64", "--metrics"],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for what in [
+        "L2-star",
+        "centered",
+        "wrap-around",
+        "star discrepancy (exact)",
+    ] {
+        assert!(out.contains(what), "{what} missing:\n{out}");
+    }
+    for family in ["gaussian", "heaviside", "disk"] {
+        let line = out.lines().find(|l| l.trim_start().starts_with(family));
+        let value: f64 = line
+            .and_then(|l| l.split_whitespace().last())
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("{family} missing:\n{out}"));
+        assert!(value > 0.0 && value < 0.1, "{family}: {value}");
+    }
+}
+
+#[test]
+fn points_bad_input_exits_2_with_a_message() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, message) in [
+        (
+            &["points", "--sampler", "nope"][..],
+            "unknown point set `nope`",
+        ),
+        (&["points", "-n", "0"][..], "at least 1"),
+        (
+            &["points", "--sampler", "poisson-disk", "-d", "3"][..],
+            "poisson-disk",
+        ),
+        (
+            &["points", "--sampler", "halton", "-d", "5000"][..],
+            "at most",
+        ),
+        (&["points", "--out", "pts.txt"][..], ".csv or .png"),
+    ] {
+        let o = lueur(args, dir.path());
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(message), "{args:?}: {}", stderr(&o));
+    }
+    assert!(files_in(dir.path()).is_empty(), "bad input writes nothing");
+}
+
+#[test]
+fn a_time_budget_stops_after_whole_passes_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = lueur(
+        &[
+            "render",
+            &scene("cornell-spheres"),
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--spp",
+            "1000000",
+            "--time",
+            "0.2",
+            "--out",
+            "t.exr",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("time budget"), "{err}");
+    assert!(dir.path().join("t.exr").exists());
+    let o = lueur(
+        &["render", &scene("cornell-spheres"), "--time", "-1"],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn an_error_target_stops_the_render_when_reached() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = lueur(
+        &[
+            "render",
+            &scene("death-star"),
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--spp",
+            "1000000",
+            "--target-error",
+            "0.05",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("target error reached"), "{err}");
+}
+
+/// SIGINT mid-render: the last complete pass is written, a whole number of
+/// spp, and the exit status says the render did not finish.
+#[cfg(unix)]
+#[test]
+fn an_interrupt_writes_the_last_complete_pass_and_exits_130() {
+    use std::time::{Duration, Instant};
+
+    let dir = tempfile::tempdir().unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_lueur"))
+        .args([
+            "render",
+            &scene("donut-mirrors"),
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--spp",
+            "1000000",
+            "--out",
+            "i.png",
+        ])
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Long enough for the first passes to complete on a slow machine.
+    std::thread::sleep(Duration::from_millis(1500));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let start = Instant::now();
+    let o = child.wait_with_output().unwrap();
+    assert!(
+        start.elapsed() < Duration::from_secs(30),
+        "the render stops promptly"
+    );
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("interrupted: wrote the"), "{err}");
+    let img = image::open(dir.path().join("i.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (32, 32));
+    assert_eq!(files_in(dir.path()).len(), 1, "no temporary file left");
+}

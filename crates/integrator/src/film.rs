@@ -49,6 +49,9 @@ impl PixelStats {
 pub struct Film {
     width: u32,
     height: u32,
+    /// Sample indices `0..spp` have been added to every pixel (less any
+    /// NaN or infinite sample, dropped and counted by the render).
+    spp: u32,
     pixels: Vec<PixelStats>,
 }
 
@@ -58,8 +61,38 @@ impl Film {
         Film {
             width,
             height,
+            spp: 0,
             pixels: vec![PixelStats::default(); width as usize * height as usize],
         }
+    }
+
+    /// Samples per pixel rendered so far: every pixel has seen sample
+    /// indices `0..spp`, so a film is always a whole number of samples per
+    /// pixel, however its render was cut into passes.
+    pub fn spp(&self) -> u32 {
+        self.spp
+    }
+
+    pub(crate) fn set_spp(&mut self, spp: u32) {
+        self.spp = spp;
+    }
+
+    /// Relative standard error of the image: the RMS over pixels and
+    /// channels of each pixel's standard error, divided by the image's mean
+    /// radiance. What `--target-error` stops on; infinite before 2 spp.
+    pub fn relative_error(&self) -> f64 {
+        let (mean, _) = self.image_mean();
+        if self.spp < 2 || !(mean > 0.0) {
+            return f64::INFINITY;
+        }
+        let n = 3.0 * self.pixels.len() as f64;
+        let var: f64 = self
+            .pixels
+            .iter()
+            .map(|p| p.variance_of_mean().element_sum() as f64)
+            .sum::<f64>()
+            / n;
+        var.sqrt() / mean
     }
 
     /// Width in pixels.

@@ -53,7 +53,7 @@ mod strategy;
 pub use camera::Camera;
 pub use film::{Film, PixelStats};
 pub use path::RayCounters;
-pub use render::{RenderOutput, RenderSettings, RenderStats, render};
+pub use render::{RenderOutput, RenderSettings, RenderStats, render, render_pass};
 pub use scene::{Hit, Light, Marching, Object, QuadSampling, Scene, TraceCounters};
 pub use strategy::Strategy;
 

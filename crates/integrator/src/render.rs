@@ -1,5 +1,7 @@
 //! The render loop: tiles in parallel, samples in order within a pixel.
 
+use std::ops::Range;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::UVec2;
@@ -104,6 +106,16 @@ pub struct RenderStats {
     pub elapsed: Duration,
 }
 
+impl RenderStats {
+    /// Adds another pass's statistics (times add up too).
+    pub fn merge(&mut self, other: &RenderStats) {
+        self.rays.merge(&other.rays);
+        self.dropped_samples += other.dropped_samples;
+        self.samples += other.samples;
+        self.elapsed += other.elapsed;
+    }
+}
+
 /// A finished render.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderOutput {
@@ -113,8 +125,9 @@ pub struct RenderOutput {
     pub stats: RenderStats,
 }
 
-/// Renders `scene`. `progress` is called after each tile with the number of
-/// pixels just finished (the library never prints; the caller draws bars).
+/// Renders `scene` in one pass of `settings.spp` samples per pixel.
+/// `progress` is called after each tile with the number of pixel samples
+/// just finished (the library never prints; the caller draws bars).
 ///
 /// Runs on the current rayon thread pool: wrap the call in
 /// `ThreadPool::install` to choose the thread count. The image does not
@@ -125,45 +138,105 @@ pub fn render(
     settings: &RenderSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<RenderOutput, RenderError> {
+    let mut film = Film::new(settings.width, settings.height);
+    let stats = render_pass(
+        scene,
+        settings,
+        &mut film,
+        settings.spp,
+        &AtomicBool::new(false),
+        progress,
+    )?
+    .expect("a render that cannot be cancelled completes");
+    Ok(RenderOutput { film, stats })
+}
+
+/// Adds sample indices `film.spp()..until` to every pixel of `film`: one
+/// pass of a progressive render. Because each pixel adds its samples in
+/// index order, rendering `0..4` then `4..8` gives the bit-identical film
+/// of rendering `0..8` at once.
+///
+/// `cancel` is polled before every pixel; once it is set the pass is
+/// abandoned, `film` is left exactly as it was (still a whole number of
+/// samples per pixel) and `Ok(None)` is returned.
+pub fn render_pass(
+    scene: &Scene,
+    settings: &RenderSettings,
+    film: &mut Film,
+    until: u32,
+    cancel: &AtomicBool,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Option<RenderStats>, RenderError> {
     settings.validate()?;
+    let (w, h) = (settings.width, settings.height);
+    if film.width() != w || film.height() != h {
+        return Err(RenderError::InvalidSetting(
+            "the film's size differs from the settings'",
+        ));
+    }
+    let from = film.spp();
+    if until <= from || until > settings.spp {
+        return Err(RenderError::InvalidSetting(
+            "a pass must add samples, and stop at or before the render's spp",
+        ));
+    }
     let start = Instant::now();
     let estimator = Estimator {
         scene,
         settings,
         march: March::new(scene, settings),
     };
-    let (w, h) = (settings.width, settings.height);
     let tiles: Vec<UVec2> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| UVec2::new(tx * TILE, ty * TILE)))
         .collect();
 
-    let results: Vec<(UVec2, Vec<PixelStats>, RayCounters, u64)> = tiles
+    let existing: &Film = film;
+    let results: Vec<Option<TileResult>> = tiles
         .par_iter()
         .map(|&origin| {
-            let r = render_tile(&estimator, origin);
-            progress(r.0.len() as u64);
-            (origin, r.0, r.1, r.2)
+            let r = render_tile(&estimator, existing, origin, from..until, cancel)?;
+            progress(r.pixels.len() as u64 * u64::from(until - from));
+            Some(r)
         })
         .collect();
+    if cancel.load(Ordering::Relaxed) || results.iter().any(Option::is_none) {
+        return Ok(None);
+    }
 
-    let mut film = Film::new(w, h);
     let mut stats = RenderStats::default();
     let pixels = film.pixels_mut();
-    for (origin, tile, counters, dropped) in results {
-        let tw = (w - origin.x).min(TILE);
-        for (i, px) in tile.into_iter().enumerate() {
-            let (x, y) = (origin.x + i as u32 % tw, origin.y + i as u32 / tw);
-            stats.samples += px.n as u64;
-            pixels[(y * w + x) as usize] = px;
+    for r in results.into_iter().flatten() {
+        let tw = (w - r.origin.x).min(TILE);
+        for (i, px) in r.pixels.into_iter().enumerate() {
+            let (x, y) = (r.origin.x + i as u32 % tw, r.origin.y + i as u32 / tw);
+            let slot = &mut pixels[(y * w + x) as usize];
+            stats.samples += u64::from(px.n - slot.n);
+            *slot = px;
         }
-        stats.rays.merge(&counters);
-        stats.dropped_samples += dropped;
+        stats.rays.merge(&r.counters);
+        stats.dropped_samples += r.dropped;
     }
+    film.set_spp(until);
     stats.elapsed = start.elapsed();
-    Ok(RenderOutput { film, stats })
+    Ok(Some(stats))
 }
 
-fn render_tile(estimator: &Estimator<'_>, origin: UVec2) -> (Vec<PixelStats>, RayCounters, u64) {
+/// One tile's pixels after a pass, and what the pass cost there.
+struct TileResult {
+    origin: UVec2,
+    pixels: Vec<PixelStats>,
+    counters: RayCounters,
+    dropped: u64,
+}
+
+/// `None` when cancelled.
+fn render_tile(
+    estimator: &Estimator<'_>,
+    film: &Film,
+    origin: UVec2,
+    samples: Range<u32>,
+    cancel: &AtomicBool,
+) -> Option<TileResult> {
     let settings = estimator.settings;
     let (w, h) = (settings.width, settings.height);
     let (tw, th) = ((w - origin.x).min(TILE), (h - origin.y).min(TILE));
@@ -173,8 +246,11 @@ fn render_tile(estimator: &Estimator<'_>, origin: UVec2) -> (Vec<PixelStats>, Ra
     let mut pixels = Vec::with_capacity((tw * th) as usize);
     for y in origin.y..origin.y + th {
         for x in origin.x..origin.x + tw {
-            let mut stats = PixelStats::default();
-            for index in 0..settings.spp {
+            if cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            let mut stats = *film.pixel(x, y);
+            for index in samples.clone() {
                 let id = SampleId {
                     pixel: [x, y],
                     index,
@@ -194,5 +270,10 @@ fn render_tile(estimator: &Estimator<'_>, origin: UVec2) -> (Vec<PixelStats>, Ra
             pixels.push(stats);
         }
     }
-    (pixels, counters, dropped)
+    Some(TileResult {
+        origin,
+        pixels,
+        counters,
+        dropped,
+    })
 }

@@ -1,0 +1,95 @@
+//! Progressive rendering for the CLI: passes of 1, 1, 2, 4, ... samples per
+//! pixel (pbrt's schedule), so the film always holds a whole number of
+//! samples per pixel and a render can stop after any pass, on a signal, a
+//! time budget or an error target, without losing what it paid for.
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::Instant;
+
+use lueur_integrator::{
+    Film, RenderError, RenderOutput, RenderSettings, RenderStats, Scene, render_pass,
+};
+
+/// Set by SIGINT, SIGTERM or SIGHUP: the current pass is abandoned.
+static CANCEL: AtomicBool = AtomicBool::new(false);
+/// Signals received so far; the second one exits at once.
+static SIGNALS: AtomicUsize = AtomicUsize::new(0);
+
+/// Exit status after an interrupt, as shells report SIGINT (128 + 2).
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// Routes SIGINT, SIGTERM and SIGHUP to [`CANCEL`]; a second signal exits
+/// immediately. Images are written to a temporary file and renamed, so even
+/// that exit cannot leave a truncated image behind.
+pub fn install_signal_handler() -> anyhow::Result<()> {
+    ctrlc::set_handler(|| {
+        if SIGNALS.fetch_add(1, Ordering::SeqCst) >= 1 {
+            eprintln!("\nsecond interrupt: exiting without writing");
+            std::process::exit(i32::from(EXIT_INTERRUPTED));
+        }
+        CANCEL.store(true, Ordering::SeqCst);
+        eprintln!("\ninterrupt: finishing with the last complete pass (again to exit now)");
+    })?;
+    Ok(())
+}
+
+/// When to stop before `spp` is reached.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Limits {
+    /// Wall-clock budget in seconds: no pass starts that is predicted to
+    /// end past it (the first pass always runs).
+    pub time: Option<f64>,
+    /// Stop once [`Film::relative_error`] is at most this.
+    pub target_error: Option<f64>,
+}
+
+/// Why a render stopped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stop {
+    /// All `spp` samples per pixel were rendered.
+    Complete,
+    /// A signal arrived; the film holds the passes completed before it.
+    Interrupted,
+    /// The next pass would have ended past the time budget.
+    TimeBudget,
+    /// The relative error reached the target (the value reached).
+    TargetError(f64),
+}
+
+/// Renders in passes until `settings.spp`, a signal or a limit.
+pub fn render(
+    scene: &Scene,
+    settings: &RenderSettings,
+    limits: Limits,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<(RenderOutput, Stop), RenderError> {
+    let start = Instant::now();
+    let mut film = Film::new(settings.width, settings.height);
+    let mut stats = RenderStats::default();
+    let mut until = 1;
+    loop {
+        match render_pass(scene, settings, &mut film, until, &CANCEL, progress)? {
+            Some(pass) => stats.merge(&pass),
+            None => return Ok((RenderOutput { film, stats }, Stop::Interrupted)),
+        }
+        let done = film.spp();
+        if done >= settings.spp {
+            return Ok((RenderOutput { film, stats }, Stop::Complete));
+        }
+        let next = done.saturating_mul(2).min(settings.spp);
+        if let Some(budget) = limits.time {
+            let elapsed = start.elapsed().as_secs_f64();
+            let per_spp = elapsed / f64::from(done);
+            if elapsed + per_spp * f64::from(next - done) > budget {
+                return Ok((RenderOutput { film, stats }, Stop::TimeBudget));
+            }
+        }
+        if let Some(target) = limits.target_error {
+            let reached = film.relative_error();
+            if reached <= target {
+                return Ok((RenderOutput { film, stats }, Stop::TargetError(reached)));
+            }
+        }
+        until = next;
+    }
+}
