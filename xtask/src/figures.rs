@@ -11,7 +11,7 @@ use lueur::integrator::{Film, RenderSettings, Strategy};
 
 use crate::compose::{color_bar, error_map, grid, stack};
 use crate::reference::{flatten, reference};
-use crate::{load_scene, project_root, render_with_bar};
+use crate::{docs_dir, load_scene, render_with_bar};
 
 /// The shipped scenes, in the order of the report's figures.
 pub const SCENES: [&str; 3] = ["death-star", "donut-mirrors", "cornell-spheres"];
@@ -49,7 +49,7 @@ const ERROR_EPSILON: f64 = 0.01;
 
 pub fn run(quick: bool) -> Result<()> {
     let plan = if quick { QUICK } else { FULL };
-    let dir = project_root().join("docs").join("figures");
+    let dir = docs_dir(quick).join("figures");
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut md = String::new();
     let flag = if quick { " --quick" } else { "" };
@@ -197,7 +197,7 @@ pub fn run(quick: bool) -> Result<()> {
         )?;
     }
 
-    let md_path = project_root().join("docs").join("FIGURES.md");
+    let md_path = docs_dir(quick).join("FIGURES.md");
     std::fs::write(&md_path, md).with_context(|| format!("writing {}", md_path.display()))?;
     eprintln!(
         "figures written to {} and {}",

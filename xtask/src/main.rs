@@ -61,6 +61,17 @@ pub fn project_root() -> PathBuf {
         .to_path_buf()
 }
 
+/// Where a command writes its documents: `docs/` for full runs, which are
+/// committed, and `target/xtask/quick/` (same layout) for `--quick` runs, so
+/// that CI and quick checks never overwrite the committed figures.
+pub fn docs_dir(quick: bool) -> PathBuf {
+    if quick {
+        project_root().join("target").join("xtask").join("quick")
+    } else {
+        project_root().join("docs")
+    }
+}
+
 /// Loads `scenes/NAME.toml`.
 pub fn load_scene(name: &str) -> Result<SceneFile> {
     let path = project_root().join("scenes").join(format!("{name}.toml"));

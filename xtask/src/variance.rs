@@ -36,7 +36,7 @@ use lueur::sampling::SamplerKind;
 use lueur::scene::SceneFile;
 
 use crate::reference::{Reference, cache_dir, flatten, reference, render_film};
-use crate::{load_scene, project_root};
+use crate::{docs_dir, load_scene};
 
 /// The scenes measured, the first one carrying the report's claims.
 const SCENES: [&str; 3] = ["donut-mirrors", "cornell-spheres", "death-star"];
@@ -127,7 +127,7 @@ pub fn run(quick: bool) -> Result<()> {
     std::fs::write(&csv_path, csv(&rows))
         .with_context(|| format!("writing {}", csv_path.display()))?;
     let md = markdown(&rows, &plan, quick, &failures)?;
-    let docs = project_root().join("docs");
+    let docs = docs_dir(quick);
     std::fs::create_dir_all(&docs).with_context(|| format!("creating {}", docs.display()))?;
     let md_path = docs.join("VARIANCE.md");
     std::fs::write(&md_path, &md).with_context(|| format!("writing {}", md_path.display()))?;
