@@ -2,6 +2,7 @@
 //! crates: it reads scene files, draws the progress bar and writes images;
 //! every decision about light lives in `lueur-integrator`.
 
+mod checkpoint;
 mod output;
 mod points;
 mod progressive;
@@ -13,7 +14,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use lueur_integrator::{Marching, RenderOutput, RenderSettings, Strategy};
+use lueur_integrator::{Film, Marching, RenderOutput, RenderSettings, Strategy};
 use lueur_sampling::SamplerKind;
 use lueur_scene::{SceneFileError, parse_scene};
 
@@ -91,6 +92,14 @@ struct RenderArgs {
     /// error over mean radiance) is at most this, e.g. 0.01.
     #[arg(long, value_name = "E")]
     target_error: Option<f64>,
+    /// Save the film's full state to this EXR after every pass, so the
+    /// render can be continued later with --resume.
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Continue from a checkpoint of the same scene and settings, up to
+    /// --spp; the result is bit-identical to one uninterrupted render.
+    #[arg(long, value_name = "FILE")]
+    resume: Option<PathBuf>,
 }
 
 fn parse_strategy(s: &str) -> Result<Strategy, String> {
@@ -213,7 +222,24 @@ fn run_render(args: RenderArgs) -> Result<()> {
         .expect("the template is valid"),
     );
     let progress = |n: u64| bar.inc(n);
-    let run = || progressive::render(&scene, &settings, limits, &progress);
+    let fingerprint = checkpoint::settings_fingerprint(&settings, args.naive);
+    let film = match &args.resume {
+        Some(path) => {
+            checkpoint::load(path, &text, &fingerprint).map_err(|e| BadInput(format!("{e:#}")))?
+        }
+        None => Film::new(settings.width, settings.height),
+    };
+    bar.inc(
+        u64::from(settings.width)
+            * u64::from(settings.height)
+            * u64::from(film.spp().min(settings.spp)),
+    );
+    let mut after_pass = |film: &Film| match &args.checkpoint {
+        Some(path) => checkpoint::save(path, film, &text, &fingerprint)
+            .with_context(|| format!("cannot write checkpoint {}", path.display())),
+        None => Ok(()),
+    };
+    let run = || progressive::render(&scene, &settings, film, limits, &progress, &mut after_pass);
     let (output, stop) = match args.threads {
         Some(0) => return Err(BadInput("--threads must be at least 1".into()).into()),
         Some(n) => rayon::ThreadPoolBuilder::new()
@@ -222,8 +248,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
             .context("cannot start the worker threads")?
             .install(run),
         None => run(),
-    }
-    .map_err(|e| BadInput(e.to_string()))?;
+    }?;
     bar.finish_and_clear();
     let output: RenderOutput = output;
     if output.film.spp() == 0 {

@@ -36,12 +36,17 @@ impl Format {
 
 /// Writes the film's mean (and for EXR its variance) to `path`.
 pub fn write_image(path: &Path, format: Format, film: &Film, exposure: f32) -> Result<()> {
+    write_atomically(path, |tmp| match format {
+        Format::Png => write_png(tmp, film, exposure),
+        Format::Exr => write_exr(tmp, film),
+    })
+}
+
+/// Runs `write` on a temporary file beside `path`, then renames it into
+/// place: readers see the old file or the whole new one, never a torn one.
+pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let tmp = temporary_path(path);
-    let result = match format {
-        Format::Png => write_png(&tmp, film, exposure),
-        Format::Exr => write_exr(&tmp, film),
-    };
-    if let Err(e) = result {
+    if let Err(e) = write(&tmp) {
         let _ = std::fs::remove_file(&tmp);
         return Err(e);
     }

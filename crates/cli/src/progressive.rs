@@ -6,9 +6,7 @@
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
-use lueur_integrator::{
-    Film, RenderError, RenderOutput, RenderSettings, RenderStats, Scene, render_pass,
-};
+use lueur_integrator::{Film, RenderOutput, RenderSettings, RenderStats, Scene, render_pass};
 
 /// Set by SIGINT, SIGTERM or SIGHUP: the current pass is abandoned.
 static CANCEL: AtomicBool = AtomicBool::new(false);
@@ -57,21 +55,32 @@ pub enum Stop {
 }
 
 /// Renders in passes until `settings.spp`, a signal or a limit.
+///
+/// Starts from `film` (empty, or a resumed checkpoint) and calls
+/// `after_pass` with the film after every complete pass (to checkpoint it).
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
+    mut film: Film,
     limits: Limits,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<(RenderOutput, Stop), RenderError> {
+    after_pass: &mut dyn FnMut(&Film) -> anyhow::Result<()>,
+) -> anyhow::Result<(RenderOutput, Stop)> {
     let start = Instant::now();
-    let mut film = Film::new(settings.width, settings.height);
     let mut stats = RenderStats::default();
-    let mut until = 1;
+    if film.spp() >= settings.spp {
+        return Ok((RenderOutput { film, stats }, Stop::Complete));
+    }
+    // pbrt's schedule: the first pass brings the film to 1 spp, each next
+    // one doubles it.
+    let mut until = film.spp().saturating_mul(2).clamp(1, settings.spp);
+    let resumed_at = film.spp();
     loop {
         match render_pass(scene, settings, &mut film, until, &CANCEL, progress)? {
             Some(pass) => stats.merge(&pass),
             None => return Ok((RenderOutput { film, stats }, Stop::Interrupted)),
         }
+        after_pass(&film)?;
         let done = film.spp();
         if done >= settings.spp {
             return Ok((RenderOutput { film, stats }, Stop::Complete));
@@ -79,7 +88,7 @@ pub fn render(
         let next = done.saturating_mul(2).min(settings.spp);
         if let Some(budget) = limits.time {
             let elapsed = start.elapsed().as_secs_f64();
-            let per_spp = elapsed / f64::from(done);
+            let per_spp = elapsed / f64::from(done - resumed_at);
             if elapsed + per_spp * f64::from(next - done) > budget {
                 return Ok((RenderOutput { film, stats }, Stop::TimeBudget));
             }

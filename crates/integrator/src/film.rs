@@ -73,6 +73,22 @@ impl Film {
         self.spp
     }
 
+    /// A film from saved statistics (a checkpoint): `pixels` row-major,
+    /// `width * height` of them, each holding at most `spp` samples.
+    /// `None` if the parts do not fit together.
+    pub fn from_parts(width: u32, height: u32, spp: u32, pixels: Vec<PixelStats>) -> Option<Film> {
+        let fits = pixels.len() == width as usize * height as usize
+            && pixels.iter().all(|p| {
+                p.n <= spp && p.mean.is_finite() && p.m2.is_finite() && p.m2.min_element() >= 0.0
+            });
+        fits.then_some(Film {
+            width,
+            height,
+            spp,
+            pixels,
+        })
+    }
+
     pub(crate) fn set_spp(&mut self, spp: u32) {
         self.spp = spp;
     }
