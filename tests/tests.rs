@@ -16,3 +16,6 @@ mod analytic;
 // The strategies against each other on the shipped scenes, and the report's
 // variance claim.
 mod strategies;
+
+// Degenerate but valid scenes, and the same scene scaled and moved far away.
+mod degenerate;

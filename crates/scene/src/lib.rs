@@ -43,7 +43,9 @@ mod parse;
 use std::collections::HashMap;
 
 use glam::{Quat, Vec3};
-use lueur_integrator::{Camera, Light, Object, QuadSampling, RenderSettings, Scene, Strategy};
+use lueur_integrator::{
+    Camera, Light, Object, QuadSampling, RenderSettings, Scene, SceneError, Strategy,
+};
 use lueur_materials::Material;
 use lueur_sampling::SamplerKind;
 use lueur_sdf_math::Sdf;
@@ -151,18 +153,35 @@ pub fn parse_scene(text: &str, file: &str) -> std::result::Result<SceneFile, Sce
     }
 
     let mut lights = Vec::new();
+    let mut light_places = Vec::new();
     for entry in array_of_tables(&src, &top, "lights")? {
         lights.push(parse_light(&src, &entry)?);
+        light_places.push((entry.span.clone(), entry.path.clone()));
     }
 
     let mut sky = None;
     if let Some(table) = top.table(&src, "sky")? {
         table.deny_unknown(&src, &["radiance"])?;
-        sky = Some(table.req_vec3(&src, "radiance", Check::NonNegative)?);
+        sky = Some(table.req_vec3(&src, "radiance", Check::Emission)?);
     }
 
-    let mut scene = Scene::new(objects, materials, lights, sky, camera)
-        .map_err(|e| src.error(0..0, "", e.to_string()))?;
+    // The checks above should leave nothing for `Scene::new` to reject;
+    // should they miss a case, the error still names the key to blame.
+    let mut scene = Scene::new(objects, materials, lights, sky, camera).map_err(|e| {
+        let (span, key) = match &e {
+            SceneError::InvalidLight(i) => light_places
+                .get(*i)
+                .cloned()
+                .unwrap_or((top.span.clone(), "lights".into())),
+            SceneError::InvalidSky => (
+                top.get("sky").map_or(top.span.clone(), |v| v.span()),
+                "sky".into(),
+            ),
+            SceneError::Camera(_) => (camera_table.span.clone(), "camera".into()),
+            _ => (top.span.clone(), "objects".into()),
+        };
+        src.error(span, &key, e.to_string())
+    })?;
     scene.quad_sampling = quad_sampling;
     Ok(SceneFile { scene, settings })
 }
@@ -301,7 +320,7 @@ fn parse_light(src: &Source<'_>, t: &Table<'_, '_>) -> Result<Light> {
             Ok(Light::Sphere {
                 center: t.req_vec3(src, "center", Check::Any)?,
                 radius: t.req_f32(src, "radius", Check::Positive)?,
-                radiance: t.req_vec3(src, "radiance", Check::NonNegative)?,
+                radiance: t.req_vec3(src, "radiance", Check::Emission)?,
             })
         }
         "quad" => {
@@ -321,7 +340,7 @@ fn parse_light(src: &Source<'_>, t: &Table<'_, '_>) -> Result<Light> {
                 corner,
                 edge_u,
                 edge_v,
-                radiance: t.req_vec3(src, "radiance", Check::NonNegative)?,
+                radiance: t.req_vec3(src, "radiance", Check::Emission)?,
             })
         }
         "directional" => {
@@ -330,7 +349,7 @@ fn parse_light(src: &Source<'_>, t: &Table<'_, '_>) -> Result<Light> {
                 direction: t
                     .req_vec3(src, "direction", Check::NonZeroVector)?
                     .normalize(),
-                irradiance: t.req_vec3(src, "irradiance", Check::NonNegative)?,
+                irradiance: t.req_vec3(src, "irradiance", Check::Emission)?,
             })
         }
         other => Err(src.error(

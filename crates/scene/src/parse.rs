@@ -282,7 +282,21 @@ pub(crate) enum Check {
     NonNegative,
     UnitInterval,
     NonZeroVector,
+    /// Radiance or irradiance: non-negative and at most [`MAX_EMISSION`].
+    Emission,
 }
+
+/// Largest radiance or irradiance a file may give. Above it, one sample's
+/// estimate (radiance times a path's throughput over its pdf), or the sum
+/// of squares a pixel accumulates, can overflow f32 and the sample would be
+/// dropped; 1e12 is far above any physical scene in any usual unit.
+pub(crate) const MAX_EMISSION: f32 = 1e12;
+
+/// Vectors that are normalised must have a length in this range: below,
+/// the squared length is subnormal and the normalised vector is not of unit
+/// length; above, the squared length overflows.
+const MIN_VECTOR_LENGTH: f32 = 1.1e-19;
+const MAX_VECTOR_LENGTH: f32 = 1.8e19;
 
 impl Check {
     fn describe(self) -> &'static str {
@@ -291,7 +305,8 @@ impl Check {
             Check::Positive => "a positive number",
             Check::NonNegative => "a non-negative number",
             Check::UnitInterval => "numbers between 0 and 1",
-            Check::NonZeroVector => "a non-zero vector",
+            Check::NonZeroVector => "a non-zero vector, of length between 1.1e-19 and 1.8e19",
+            Check::Emission => "a non-negative number at most 1e12",
         }
     }
 
@@ -301,6 +316,7 @@ impl Check {
             Check::Positive => x > 0.0,
             Check::NonNegative => x >= 0.0,
             Check::UnitInterval => (0.0..=1.0).contains(&x),
+            Check::Emission => (0.0..=MAX_EMISSION).contains(&x),
         }
     }
 
@@ -314,7 +330,10 @@ impl Check {
 
     fn apply_vec3(self, src: &Source<'_>, v: Vec3, span: Range<usize>, path: &str) -> Result<Vec3> {
         let ok = match self {
-            Check::NonZeroVector => v.length_squared() > 0.0 && v.length().is_finite(),
+            Check::NonZeroVector => {
+                (MIN_VECTOR_LENGTH..=MAX_VECTOR_LENGTH).contains(&v.length())
+                    && v.length_squared() >= f32::MIN_POSITIVE
+            }
             _ => v.to_array().iter().all(|&x| self.ok(x)),
         };
         if ok {
