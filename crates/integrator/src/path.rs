@@ -91,6 +91,9 @@ pub(crate) struct SurfacePoint {
     pub n: Vec3,
     /// Where rays leaving the surface start.
     pub origin: Vec3,
+    /// Whether the ray arrived from inside the solid (the normal was
+    /// flipped inward), so rays leaving this point travel inside too.
+    pub inside: bool,
 }
 
 impl SurfacePoint {
@@ -112,7 +115,8 @@ impl SurfacePoint {
             hit
         };
         let residual = (sdf.distance(p) / g.max(1e-3)).abs();
-        let n = if n_geo.dot(wo) < 0.0 { -n_geo } else { n_geo };
+        let inside = n_geo.dot(wo) < 0.0;
+        let n = if inside { -n_geo } else { n_geo };
         let offset = spawn_floor.max(if residual.is_finite() {
             4.0 * residual
         } else {
@@ -122,6 +126,7 @@ impl SurfacePoint {
             p,
             n,
             origin: p + n * offset,
+            inside,
         }
     }
 
@@ -147,6 +152,11 @@ struct Previous {
     n: Vec3,
     /// pdf with which the BSDF chose the current direction (MIS only).
     bsdf_pdf: f32,
+    /// Whether the path travels inside a solid: it started at a camera
+    /// inside an object and every vertex since was shaded on the inside.
+    /// (Only then: an outside hit whose coarse normal faces away from the
+    /// viewer is rounding, not a way in.)
+    in_solid: bool,
     /// Whether emission found along this ray counts in full: camera rays,
     /// delta bounces, and every strategy but `mis` (where next-event
     /// estimation has already counted part of it).
@@ -187,10 +197,12 @@ pub(crate) fn radiance(
         p: ray.origin,
         n: Vec3::ZERO,
         bsdf_pdf: 0.0,
+        in_solid: false,
         full_weight: true,
     };
     let mut depth = 0u32;
     let mut params = march.camera;
+    let started_inside = scene.distance(ray.origin) < 0.0;
 
     loop {
         let kind = if depth == 0 {
@@ -198,7 +210,11 @@ pub(crate) fn radiance(
         } else {
             &mut counters.bounce
         };
-        let hit = scene.intersect(&ray, &params, kind);
+        let hit = if depth == 0 || previous.in_solid {
+            scene.intersect_maybe_inside(&ray, &params, kind)
+        } else {
+            scene.intersect(&ray, &params, kind)
+        };
         let (t, object, epsilon) = match hit {
             None => {
                 if let Some(sky) = scene.sky {
@@ -339,6 +355,7 @@ pub(crate) fn radiance(
             break;
         }
         previous = Previous {
+            in_solid: surface.inside && (depth == 1 && started_inside || previous.in_solid),
             p,
             n,
             bsdf_pdf,

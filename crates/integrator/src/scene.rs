@@ -231,6 +231,22 @@ impl DistanceField for Naive<'_> {
     }
 }
 
+/// The inside of [`Geometry`]: the negated field, whose zero set is the
+/// same surface and which is positive inside objects, so the tracer can
+/// march a ray that starts inside a solid to the wall it leaves through.
+struct Inside<'a>(&'a Geometry);
+
+impl DistanceField for Inside<'_> {
+    #[inline]
+    fn distance(&self, p: Vec3) -> f32 {
+        -self.0.distance_naive(p)
+    }
+
+    fn lipschitz(&self) -> f32 {
+        self.0.lipschitz
+    }
+}
+
 /// [`Geometry`] with bounding-sphere culling, for fast marching.
 struct Culled<'a>(&'a Geometry);
 
@@ -468,14 +484,55 @@ impl Scene {
         params: &TraceParams,
         counters: &mut TraceCounters,
     ) -> Option<Hit> {
+        self.intersect_ray(ray, params, counters, false)
+    }
+
+    /// [`Scene::intersect`] for a ray that may start inside a solid: a
+    /// camera ray, or a ray leaving a surface that was shaded on its inside.
+    /// If its origin is below a surface (not merely in its shell), the ray
+    /// is marched by the negated field to the wall it leaves through, so
+    /// that a camera inside an object sees the inner wall and paths there
+    /// stay inside. Costs one field evaluation.
+    ///
+    /// Other rays never do this: a secondary origin a hair under a surface
+    /// is rounding, which the projection at the next vertex repairs.
+    pub fn intersect_maybe_inside(
+        &self,
+        ray: &Ray,
+        params: &TraceParams,
+        counters: &mut TraceCounters,
+    ) -> Option<Hit> {
+        self.intersect_ray(ray, params, counters, true)
+    }
+
+    fn intersect_ray(
+        &self,
+        ray: &Ray,
+        params: &TraceParams,
+        counters: &mut TraceCounters,
+        maybe_inside: bool,
+    ) -> Option<Hit> {
         let light_hit = self.intersect_lights(ray, params.t_max, None);
         let t_max = light_hit.map_or(params.t_max, |(t, _)| t);
         let mut surface = None;
         if !self.objects.is_empty() {
             let p = TraceParams { t_max, ..*params };
-            let outcome = self.trace(ray, &p);
+            let start = ray.at(p.t_min);
+            let inside = maybe_inside && self.distance(start) < -p.eps_abs.max(p.eps_rel * p.t_min);
+            let outcome = if inside {
+                sphere_trace(&Inside(&self.geometry), ray, &p)
+            } else {
+                self.trace(ray, &p)
+            };
             counters.record(&outcome);
-            if let Some(t) = outcome.hit_t() {
+            // Inside a closed solid every ray ends on its wall: one that
+            // gives up at the step cap (crawling along the wall) has not
+            // escaped, so it stops where it is rather than seeing the sky.
+            let t_hit = match outcome {
+                TraceOutcome::GaveUp { t, .. } if inside => Some(t),
+                _ => outcome.hit_t(),
+            };
+            if let Some(t) = t_hit {
                 let object = self.closest_object(ray.at(t));
                 let epsilon = params.eps_abs.max(params.eps_rel * t);
                 surface = Some(Hit::Surface { t, object, epsilon });
