@@ -105,12 +105,11 @@ pub fn load(path: &Path, scene_text: &str, fingerprint: &str) -> Result<Film> {
         .all_attributes()
         .from_file(path)
         .with_context(|| format!("cannot read checkpoint {name}"))?;
-    let Some(layer) = image.layer_data.iter().find(|l| {
-        l.attributes
-            .layer_name
-            .as_ref()
-            .is_some_and(|n| n == LAYER)
-    }) else {
+    let Some(layer) = image
+        .layer_data
+        .iter()
+        .find(|l| l.attributes.layer_name.as_ref().is_some_and(|n| n == LAYER))
+    else {
         bail!("{name} is not a lueur checkpoint (no `{LAYER}` layer)");
     };
     let attr = |key: &str| layer.attributes.other.get(&Text::from(key));

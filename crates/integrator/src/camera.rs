@@ -32,10 +32,19 @@ impl Camera {
                 "`look_at` must differ from `position`".into(),
             ));
         }
-        let right = forward.cross(up).normalize_or_zero();
+        // Nearly parallel is as bad as parallel: the cross product is then
+        // mostly rounding and the image's roll is arbitrary. 1e-3 is about
+        // 0.06 degrees between `up` and the view direction.
+        let up_unit = up.normalize_or_zero();
+        let cross = forward.cross(up_unit);
+        let right = if cross.length() > 1e-3 {
+            cross.normalize()
+        } else {
+            Vec3::ZERO
+        };
         if right == Vec3::ZERO || !right.is_finite() {
             return Err(SceneError::Camera(
-                "`up` must not be zero nor parallel to the view direction (look_at - position)"
+                "`up` must not be zero nor (nearly) parallel to the view direction (look_at - position)"
                     .into(),
             ));
         }

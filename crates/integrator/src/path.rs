@@ -67,8 +67,8 @@ impl March {
         };
         // Rays leave surfaces at least this far above them: far above the
         // secondary hit threshold at their start (eps_abs), and above the
-        // f32 rounding of positions in a scene of this size.
-        let spawn_floor = (64.0 * eps_abs).max(16.0 * f32::EPSILON * scale);
+        // f32 rounding of positions this far from the origin.
+        let spawn_floor = (64.0 * eps_abs).max(8.0 * f32::EPSILON * scene.extent());
         March {
             camera,
             secondary,

@@ -117,7 +117,8 @@ pub struct Scene {
     /// Which samplable emitters exist: indices into `lights`, then the sky.
     emitters: Vec<Emitter>,
     emitter_choice: Option<DiscreteDistribution>,
-    scale: f32,
+    size: f32,
+    extent: f32,
 }
 
 /// An emitter that light sampling can choose.
@@ -396,33 +397,42 @@ impl Scene {
         // which depends on the scene's extent; measured first, changed later.
         let emitter_choice = DiscreteDistribution::uniform(emitters.len());
 
-        let mut scale: f32 = camera.position().length();
+        // Two lengths, for two different errors. `size` (the radius of a
+        // box around camera, bounded objects and lights) sets the scene's
+        // own scale: absolute epsilons and the far limit follow it, so a
+        // scene scaled by 1e-3 or 1e3 renders alike. `extent` (the largest
+        // distance from the origin) sets the f32 rounding of positions: a
+        // unit-size scene 1e3 away from the origin must not be marched with
+        // epsilons 1e3 times larger, only with offsets above the rounding.
+        let mut lo = camera.position();
+        let mut hi = lo;
+        let mut include = |c: Vec3, r: f32| {
+            lo = lo.min(c - Vec3::splat(r));
+            hi = hi.max(c + Vec3::splat(r));
+        };
         for o in &objects {
             if let Some((c, r)) = o.sdf.bounding_sphere() {
-                scale = scale.max(c.length() + r);
+                include(c, r);
             }
         }
         for l in &lights {
             match *l {
-                Light::Sphere { center, radius, .. } => scale = scale.max(center.length() + radius),
+                Light::Sphere { center, radius, .. } => include(center, radius),
                 Light::Quad {
                     corner,
                     edge_u,
                     edge_v,
                     ..
                 } => {
-                    scale = scale.max(
-                        (corner + 0.5 * (edge_u + edge_v)).length() + (edge_u + edge_v).length(),
-                    )
+                    include(corner, 0.0);
+                    include(corner + edge_u + edge_v, 0.0);
                 }
                 Light::Directional { .. } => {}
             }
         }
-        let scale = if scale.is_finite() && scale > 0.0 {
-            scale
-        } else {
-            1.0
-        };
+        let positive_or_one = |v: f32| if v.is_finite() && v > 0.0 { v } else { 1.0 };
+        let size = positive_or_one(0.5 * (hi - lo).length());
+        let extent = positive_or_one(lo.abs().max(hi.abs()).length());
 
         Ok(Scene {
             objects,
@@ -435,15 +445,23 @@ impl Scene {
             geometry,
             emitters,
             emitter_choice,
-            scale,
+            size,
+            extent,
         })
     }
 
-    /// A length that bounds the scene's extent from the origin: absolute
-    /// epsilons and the far limit are proportional to it, so a scene scaled
-    /// by 1e-3 or 1e3 renders alike.
+    /// The scene's own length scale: the radius of a box around the camera,
+    /// the bounded objects and the lights. Absolute epsilons and the far
+    /// limit are proportional to it, so a scene scaled by 1e-3 or 1e3
+    /// renders alike.
     pub fn scale(&self) -> f32 {
-        self.scale
+        self.size
+    }
+
+    /// The largest distance of the scene from the origin, which sets the
+    /// f32 rounding of every position in it.
+    pub fn extent(&self) -> f32 {
+        self.extent
     }
 
     /// The union of all objects as a distance field, evaluated as [`Scene::marching`]
