@@ -473,4 +473,14 @@ fn huge_images_and_sample_counts_are_validated_not_rendered() {
     let err = reject(&base.replace("spp = 1048576", "spp = 16777217"));
     assert_eq!(err.key, "render.spp");
     assert!(err.message.contains("between 1 and 16777216"), "{err}");
+    // Flags go through the same bounds, and a film too large to allocate
+    // sensibly is refused before any allocation.
+    let mut s = file.settings.clone();
+    (s.width, s.height) = (65_536, 65_536);
+    let err = s.validate().unwrap_err().to_string();
+    assert!(err.contains("2^28 pixels"), "{err}");
+    (s.width, s.height, s.spp) = (16, 16, (1 << 24) + 1);
+    assert!(s.validate().is_err());
+    (s.width, s.spp) = (65_537, 1);
+    assert!(s.validate().is_err());
 }

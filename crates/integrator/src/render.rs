@@ -16,6 +16,14 @@ use crate::{RenderError, Scene, Strategy};
 /// cores stay busy to the end, large enough that scheduling is negligible.
 const TILE: u32 = 16;
 
+/// Largest image side accepted.
+pub const MAX_IMAGE_SIDE: u32 = 65_536;
+/// Largest number of pixels accepted (the film holds 28 bytes per pixel).
+pub const MAX_PIXELS: u64 = 1 << 28;
+/// Largest spp accepted: beyond 2^24 a pixel's sample count would no longer
+/// be exact in the f32 arithmetic of its running mean.
+pub const MAX_SPP: u32 = 1 << 24;
+
 /// Everything that decides an image besides the scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -73,6 +81,22 @@ impl RenderSettings {
         }
         if self.spp == 0 {
             return Err(RenderError::NoSamples);
+        }
+        // The same bounds as scene files, so flags cannot go around them;
+        // and a film beyond 2^28 pixels (28 bytes each: 7.5 GB) is refused
+        // here rather than failing to allocate halfway.
+        if self.width > MAX_IMAGE_SIDE || self.height > MAX_IMAGE_SIDE {
+            return Err(RenderError::InvalidSetting(
+                "width and height must be at most 65536",
+            ));
+        }
+        if u64::from(self.width) * u64::from(self.height) > MAX_PIXELS {
+            return Err(RenderError::InvalidSetting(
+                "the image has more than 2^28 pixels (its film would take over 7.5 GB)",
+            ));
+        }
+        if self.spp > MAX_SPP {
+            return Err(RenderError::InvalidSetting("spp must be at most 2^24"));
         }
         if self.max_steps == 0 {
             return Err(RenderError::InvalidSetting("max_steps must be at least 1"));
