@@ -75,6 +75,18 @@ impl TraceOutcome {
     }
 }
 
+/// The factor from field values to ray parameter, `1 / (L |dir|)`: one
+/// division per trace, not per step. `None` for a zero or non-finite
+/// direction. A `lipschitz()` that is NaN, zero or negative breaks the
+/// field's contract and is replaced by 1 rather than trusted.
+#[inline]
+fn step_scale<F: DistanceField + ?Sized>(field: &F, ray: &Ray) -> Option<f32> {
+    let lipschitz = field.lipschitz();
+    let lipschitz = if lipschitz > 0.0 { lipschitz } else { 1.0 };
+    let speed = ray.dir.length();
+    (speed > 0.0 && speed.is_finite()).then(|| 1.0 / (lipschitz * speed))
+}
+
 /// Plain Hart sphere tracing: step = f(p) / L.
 ///
 /// Hart 1996, "Sphere tracing": if `f` is L-Lipschitz, the ball of radius `f(p) / L` around
@@ -96,17 +108,12 @@ pub fn sphere_trace<F: DistanceField + ?Sized>(
     ray: &Ray,
     params: &TraceParams,
 ) -> TraceOutcome {
-    let lipschitz = field.lipschitz();
-    let lipschitz = if lipschitz > 0.0 { lipschitz } else { 1.0 };
-    let speed = ray.dir.length();
-    if !(speed > 0.0 && speed.is_finite()) {
+    let Some(step_scale) = step_scale(field, ray) else {
         return TraceOutcome::GaveUp {
             t: params.t_min,
             steps: 0,
         };
-    }
-    // One division per trace, not per step.
-    let step_scale = 1.0 / (lipschitz * speed);
+    };
 
     let mut t = params.t_min;
     let mut steps = 0;
@@ -181,16 +188,12 @@ pub fn sphere_trace_relaxed<F: DistanceField + ?Sized>(
     if !(omega_max > 1.0 && omega_max.is_finite()) {
         return sphere_trace(field, ray, params);
     }
-    let lipschitz = field.lipschitz();
-    let lipschitz = if lipschitz > 0.0 { lipschitz } else { 1.0 };
-    let speed = ray.dir.length();
-    if !(speed > 0.0 && speed.is_finite()) {
+    let Some(step_scale) = step_scale(field, ray) else {
         return TraceOutcome::GaveUp {
             t: params.t_min,
             steps: 0,
         };
-    }
-    let step_scale = 1.0 / (lipschitz * speed);
+    };
 
     let mut t = params.t_min;
     // The previous sample and its field value; the step from it to `t` in field units
