@@ -47,6 +47,9 @@ pub(crate) struct March {
     pub secondary: TraceParams,
     /// Smallest offset of a ray's origin above the surface it leaves.
     pub spawn_floor: f32,
+    /// Whether the (pinhole) camera sits inside a solid: every camera ray
+    /// then starts inside. Decided once per render, not per ray.
+    pub camera_inside: bool,
 }
 
 impl March {
@@ -73,6 +76,7 @@ impl March {
             camera,
             secondary,
             spawn_floor,
+            camera_inside: scene.distance(scene.camera.position()) < 0.0,
         }
     }
 }
@@ -202,7 +206,7 @@ pub(crate) fn radiance(
     };
     let mut depth = 0u32;
     let mut params = march.camera;
-    let started_inside = scene.distance(ray.origin) < 0.0;
+    let started_inside = march.camera_inside;
 
     loop {
         let kind = if depth == 0 {
@@ -210,7 +214,7 @@ pub(crate) fn radiance(
         } else {
             &mut counters.bounce
         };
-        let hit = if depth == 0 || previous.in_solid {
+        let hit = if depth == 0 && started_inside || previous.in_solid {
             scene.intersect_maybe_inside(&ray, &params, kind)
         } else {
             scene.intersect(&ray, &params, kind)
