@@ -31,29 +31,19 @@ static MATRICES: LazyLock<Vec<[u32; 32]>> = LazyLock::new(|| {
 /// columns `4q..4q+4` of dimension `j` selected by the bits of `b`, so a
 /// point costs 8 table reads instead of one branch per index bit (a
 /// scrambled index has about 16 bits set). 128 KiB for 256 dimensions.
-static NIBBLES: LazyLock<Vec<[[u32; 16]; 8]>> = LazyLock::new(|| {
-    MATRICES
-        .iter()
-        .map(|v| {
-            let mut table = [[0u32; 16]; 8];
-            for (q, row) in table.iter_mut().enumerate() {
-                for (b, entry) in row.iter_mut().enumerate() {
-                    *entry = (0..4)
-                        .filter(|bit| (b >> bit) & 1 == 1)
-                        .fold(0, |x, bit| x ^ v[4 * q + bit]);
-                }
-            }
-            table
-        })
-        .collect()
-});
+static NIBBLES: LazyLock<Vec<[[u32; 16]; 8]>> = LazyLock::new(|| nibble_tables(|v, k| v[k]));
 
 /// The same in the bit-reversed domain: `REVERSED[j][q][b]` is the XOR of
 /// the reversed columns `31 - (4q + bit)` for the set bits of `b`, so that
 /// `sobol_reversed(index.reverse_bits())` is `sobol_u32(index).reverse_bits()`.
 /// Owen scrambling works on reversed bits (Burley 2020), and staying there
 /// saves two bit reversals per scrambled sample (as `sobol_burley` does).
-static REVERSED: LazyLock<Vec<[[u32; 16]; 8]>> = LazyLock::new(|| {
+static REVERSED: LazyLock<Vec<[[u32; 16]; 8]>> =
+    LazyLock::new(|| nibble_tables(|v, k| v[31 - k].reverse_bits()));
+
+/// Per dimension, `table[q][b]` = XOR of `column(matrix, 4q + bit)` over the
+/// set bits of `b`: the shared construction of [`NIBBLES`] and [`REVERSED`].
+fn nibble_tables(column: impl Fn(&[u32; 32], usize) -> u32) -> Vec<[[u32; 16]; 8]> {
     MATRICES
         .iter()
         .map(|v| {
@@ -62,13 +52,13 @@ static REVERSED: LazyLock<Vec<[[u32; 16]; 8]>> = LazyLock::new(|| {
                 for (b, entry) in row.iter_mut().enumerate() {
                     *entry = (0..4)
                         .filter(|bit| (b >> bit) & 1 == 1)
-                        .fold(0, |x, bit| x ^ v[31 - (4 * q + bit)].reverse_bits());
+                        .fold(0, |x, bit| x ^ column(v, 4 * q + bit));
                 }
             }
             table
         })
         .collect()
-});
+}
 
 /// `sobol_u32(r.reverse_bits(), dimension).reverse_bits()`, from tables.
 #[inline]
