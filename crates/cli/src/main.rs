@@ -8,6 +8,7 @@ mod points;
 mod progressive;
 mod stats;
 
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -41,6 +42,26 @@ enum Command {
     /// Generate a point set (CSV or PNG plot) and measure it: discrepancies
     /// and integration error.
     Points(points::PointsArgs),
+    /// Combine the shards of one render (saved by `render --sample-range
+    /// A..B --checkpoint FILE`) into the image of all their samples,
+    /// bit-identical to rendering them at once.
+    Merge(MergeArgs),
+}
+
+#[derive(Parser)]
+struct MergeArgs {
+    /// The shards' checkpoint files, in any order.
+    #[arg(required = true)]
+    shards: Vec<PathBuf>,
+    /// Output image; the extension picks the format (.png or .exr).
+    #[arg(long, short)]
+    out: PathBuf,
+    /// Also save the merged film as a checkpoint, to resume or merge again.
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Exposure in stops applied before PNG encoding (EXR stays linear).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    exposure: f32,
 }
 
 #[derive(Parser)]
@@ -100,6 +121,27 @@ struct RenderArgs {
     /// --spp; the result is bit-identical to one uninterrupted render.
     #[arg(long, value_name = "FILE")]
     resume: Option<PathBuf>,
+    /// Render only sample indices START..END of the --spp total: one shard
+    /// of a render split across processes or machines. Needs --checkpoint,
+    /// where the shard is saved for `lueur merge`; --out is then optional.
+    #[arg(long, value_name = "START..END", value_parser = parse_sample_range)]
+    sample_range: Option<Range<u32>>,
+}
+
+fn parse_sample_range(s: &str) -> Result<Range<u32>, String> {
+    let (a, b) = s
+        .split_once("..")
+        .ok_or_else(|| format!("expected START..END (e.g. 0..64), got `{s}`"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|e| format!("`{v}` in `{s}` is not a sample index: {e}"))
+    };
+    let (a, b) = (parse(a)?, parse(b)?);
+    if a >= b {
+        return Err(format!("the range {a}..{b} is empty"));
+    }
+    Ok(a..b)
 }
 
 fn parse_strategy(s: &str) -> Result<Strategy, String> {
@@ -166,6 +208,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => run_render(args),
         Command::Points(args) => points::run_points(args),
+        Command::Merge(args) => run_merge(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -200,11 +243,35 @@ fn run_render(args: RenderArgs) -> Result<()> {
         scene.marching = Marching::Naive;
     }
     let settings = apply_flags(parsed.settings, &args)?;
-    let out = match &args.out {
-        Some(p) => p.clone(),
-        None => default_output(&args.scene),
+    let range = match &args.sample_range {
+        Some(r) if r.end > settings.spp => {
+            return Err(BadInput(format!(
+                "--sample-range {}..{} ends past the render's {} spp (set the total with --spp)",
+                r.start, r.end, settings.spp
+            ))
+            .into());
+        }
+        Some(_) if args.checkpoint.is_none() => {
+            return Err(BadInput(
+                "--sample-range renders a shard: save it with --checkpoint FILE, for `lueur merge`"
+                    .into(),
+            )
+            .into());
+        }
+        Some(r) => r.clone(),
+        None => 0..settings.spp,
     };
-    let format = output::Format::from_path(&out).map_err(|e| BadInput(e.to_string()))?;
+    // A shard's image is optional; a whole render always writes one.
+    let out = match (&args.out, &args.sample_range) {
+        (Some(p), _) => Some(p.clone()),
+        (None, Some(_)) => None,
+        (None, None) => Some(default_output(&args.scene)),
+    };
+    let format = out
+        .as_deref()
+        .map(output::Format::from_path)
+        .transpose()
+        .map_err(|e| BadInput(e.to_string()))?;
 
     let limits = progressive::Limits {
         time: positive(args.time, "--time")?,
@@ -212,9 +279,8 @@ fn run_render(args: RenderArgs) -> Result<()> {
     };
     progressive::install_signal_handler()?;
 
-    let bar = ProgressBar::new(
-        u64::from(settings.width) * u64::from(settings.height) * u64::from(settings.spp),
-    );
+    let pixels = u64::from(settings.width) * u64::from(settings.height);
+    let bar = ProgressBar::new(pixels * u64::from(range.end - range.start));
     bar.set_style(
         ProgressStyle::with_template(
             "{spinner} [{elapsed_precise}] {wide_bar} {percent}% ETA {eta}",
@@ -225,21 +291,39 @@ fn run_render(args: RenderArgs) -> Result<()> {
     let fingerprint = checkpoint::settings_fingerprint(&settings, args.naive);
     let film = match &args.resume {
         Some(path) => {
-            checkpoint::load(path, &text, &fingerprint).map_err(|e| BadInput(format!("{e:#}")))?
+            let film = checkpoint::load(path, &text, &fingerprint)
+                .map_err(|e| BadInput(format!("{e:#}")))?;
+            if film.samples().start != range.start {
+                return Err(BadInput(format!(
+                    "{} holds samples {:?}, which do not start at {}",
+                    path.display(),
+                    film.samples(),
+                    range.start
+                ))
+                .into());
+            }
+            film
         }
-        None => Film::new(settings.width, settings.height),
+        None => Film::starting_at(settings.width, settings.height, range.start),
     };
-    bar.inc(
-        u64::from(settings.width)
-            * u64::from(settings.height)
-            * u64::from(film.spp().min(settings.spp)),
-    );
+    bar.inc(pixels * u64::from(film.spp().min(range.end - range.start)));
     let mut after_pass = |film: &Film| match &args.checkpoint {
         Some(path) => checkpoint::save(path, film, &text, &fingerprint)
             .with_context(|| format!("cannot write checkpoint {}", path.display())),
         None => Ok(()),
     };
-    let run = || progressive::render(&scene, &settings, film, limits, &progress, &mut after_pass);
+    let end = range.end;
+    let run = || {
+        progressive::render(
+            &scene,
+            &settings,
+            film,
+            end,
+            limits,
+            &progress,
+            &mut after_pass,
+        )
+    };
     let (output, stop) = match args.threads {
         Some(0) => return Err(BadInput("--threads must be at least 1".into()).into()),
         Some(n) => rayon::ThreadPoolBuilder::new()
@@ -256,21 +340,27 @@ fn run_render(args: RenderArgs) -> Result<()> {
         return Err(Interrupted(0).into());
     }
 
-    output::write_image(&out, format, &output.film, args.exposure)
-        .with_context(|| format!("cannot write {}", out.display()))?;
+    if let (Some(out), Some(format)) = (&out, format) {
+        output::write_image(out, format, &output.film, args.exposure)
+            .with_context(|| format!("cannot write {}", out.display()))?;
+    }
 
     let stats = &output.stats;
     let secs = stats.elapsed.as_secs_f64();
+    let samples = match args.sample_range {
+        Some(_) => format!("samples {:?} of {}", output.film.samples(), settings.spp),
+        None => format!("{} spp", output.film.spp()),
+    };
+    let destination = out.as_ref().or(args.checkpoint.as_ref());
     eprintln!(
-        "rendered {}x{} at {} spp ({}, {}) in {:.2} s, {:.2} M samples/s -> {}",
+        "rendered {}x{} at {samples} ({}, {}) in {:.2} s, {:.2} M samples/s -> {}",
         settings.width,
         settings.height,
-        output.film.spp(),
         settings.strategy,
         settings.sampler.name(),
         secs,
         stats.samples as f64 / secs.max(1e-9) / 1e6,
-        out.display()
+        destination.map_or_else(String::new, |p| p.display().to_string())
     );
     if stats.dropped_samples > 0 {
         eprintln!(
@@ -287,14 +377,91 @@ fn run_render(args: RenderArgs) -> Result<()> {
             "time budget of {} s reached: stopped at {} of {} spp",
             args.time.unwrap_or_default(),
             output.film.spp(),
-            settings.spp
+            range.end - range.start
         ),
         progressive::Stop::TargetError(e) => eprintln!(
             "target error reached: relative error {e:.4} at {} of {} spp",
             output.film.spp(),
-            settings.spp
+            range.end - range.start
         ),
         progressive::Stop::Interrupted => return Err(Interrupted(output.film.spp()).into()),
+    }
+    Ok(())
+}
+
+fn run_merge(args: MergeArgs) -> Result<()> {
+    let format = output::Format::from_path(&args.out).map_err(|e| BadInput(e.to_string()))?;
+    if !args.exposure.is_finite() {
+        bail!(BadInput("--exposure must be finite".into()));
+    }
+    let mut shards = Vec::new();
+    let mut first: Option<(PathBuf, String, String)> = None;
+    for path in &args.shards {
+        let saved = checkpoint::read_film(path).map_err(|e| BadInput(format!("{e:#}")))?;
+        match &first {
+            None => {
+                first = Some((
+                    path.clone(),
+                    saved.scene_text.clone(),
+                    saved.fingerprint.clone(),
+                ))
+            }
+            Some((p, scene, _)) if *scene != saved.scene_text => bail!(BadInput(format!(
+                "{} and {} are renders of different scene files; cannot merge",
+                p.display(),
+                path.display()
+            ))),
+            Some((p, _, settings)) if *settings != saved.fingerprint => {
+                bail!(BadInput(format!(
+                    "{} and {} were rendered with different settings; cannot merge.\n  {}: {settings}\n  {}: {}",
+                    p.display(),
+                    path.display(),
+                    p.display(),
+                    path.display(),
+                    saved.fingerprint
+                )))
+            }
+            Some(_) => {}
+        }
+        shards.push((path.clone(), saved.film));
+    }
+    let (_, scene_text, fingerprint) = first.expect("clap requires one shard");
+    // Name the files on either side of a gap or an overlap.
+    shards.sort_by_key(|(_, f)| f.samples().start);
+    for pair in shards.windows(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        if a.1.samples().end != b.1.samples().start {
+            bail!(BadInput(format!(
+                "{} holds samples {:?} and {} holds {:?}: shards must follow each other \
+                 without gap or overlap",
+                a.0.display(),
+                a.1.samples(),
+                b.0.display(),
+                b.1.samples()
+            )));
+        }
+    }
+    let count = shards.len();
+    let film = Film::merge(shards.into_iter().map(|(_, f)| f).collect())
+        .map_err(|e| BadInput(format!("cannot merge: {e}")))?;
+    output::write_image(&args.out, format, &film, args.exposure)
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    if let Some(path) = &args.checkpoint {
+        checkpoint::save(path, &film, &scene_text, &fingerprint)
+            .with_context(|| format!("cannot write checkpoint {}", path.display()))?;
+    }
+    eprintln!(
+        "merged {count} shards: samples {:?} ({} spp) -> {}",
+        film.samples(),
+        film.spp(),
+        args.out.display()
+    );
+    if film.samples().start != 0 {
+        eprintln!(
+            "warning: the shards start at sample {}, not 0: the image is valid, \
+             but not the first samples of the render",
+            film.samples().start
+        );
     }
     Ok(())
 }

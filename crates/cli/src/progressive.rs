@@ -54,42 +54,51 @@ pub enum Stop {
     TargetError(f64),
 }
 
-/// Renders in passes until `settings.spp`, a signal or a limit.
+/// Renders in passes until sample index `end` (`settings.spp`, or a
+/// shard's end), a signal or a limit.
 ///
-/// Starts from `film` (empty, or a resumed checkpoint) and calls
-/// `after_pass` with the film after every complete pass (to checkpoint it).
+/// Starts from `film` (empty, a resumed checkpoint, or an empty shard that
+/// starts past 0) and calls `after_pass` with the film after every complete
+/// pass (to checkpoint it).
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
     mut film: Film,
+    end: u32,
     limits: Limits,
     progress: &(dyn Fn(u64) + Sync),
     after_pass: &mut dyn FnMut(&Film) -> anyhow::Result<()>,
 ) -> anyhow::Result<(RenderOutput, Stop)> {
     let start = Instant::now();
     let mut stats = RenderStats::default();
-    if film.spp() >= settings.spp {
-        return Ok((RenderOutput { film, stats }, Stop::Complete));
-    }
+    let first = film.samples().start;
     // pbrt's schedule: the first pass brings the film to 1 spp, each next
     // one doubles it.
-    let mut until = film.spp().saturating_mul(2).clamp(1, settings.spp);
+    let next_end = |film: &Film| {
+        let done = film.spp();
+        first.saturating_add(done.saturating_mul(2).max(1)).min(end)
+    };
+    if film.samples().end >= end {
+        return Ok((RenderOutput { film, stats }, Stop::Complete));
+    }
     let resumed_at = film.spp();
+    let mut until = next_end(&film);
     loop {
         match render_pass(scene, settings, &mut film, until, &CANCEL, progress)? {
             Some(pass) => stats.merge(&pass),
             None => return Ok((RenderOutput { film, stats }, Stop::Interrupted)),
         }
         after_pass(&film)?;
-        let done = film.spp();
-        if done >= settings.spp {
+        if film.samples().end >= end {
             return Ok((RenderOutput { film, stats }, Stop::Complete));
         }
-        let next = done.saturating_mul(2).min(settings.spp);
+        let done = film.spp();
+        let next = next_end(&film);
         if let Some(budget) = limits.time {
             let elapsed = start.elapsed().as_secs_f64();
             let per_spp = elapsed / f64::from(done - resumed_at);
-            if elapsed + per_spp * f64::from(next - done) > budget {
+            let more = f64::from(next - film.samples().end);
+            if elapsed + per_spp * more > budget {
                 return Ok((RenderOutput { film, stats }, Stop::TimeBudget));
             }
         }

@@ -318,11 +318,10 @@ fn an_error_target_stops_the_render_when_reached() {
     assert!(err.contains("target error reached"), "{err}");
 }
 
-/// SIGINT mid-render: the last complete pass is written, a whole number of
-/// spp, and the exit status says the render did not finish.
+/// A signal mid-render: the last complete pass is written, a whole number
+/// of spp, and the exit status says the render did not finish.
 #[cfg(unix)]
-#[test]
-fn an_interrupt_writes_the_last_complete_pass_and_exits_130() {
+fn interrupt_with(signal: &str) {
     use std::time::{Duration, Instant};
 
     let dir = tempfile::tempdir().unwrap();
@@ -346,7 +345,7 @@ fn an_interrupt_writes_the_last_complete_pass_and_exits_130() {
     // Long enough for the first passes to complete on a slow machine.
     std::thread::sleep(Duration::from_millis(1500));
     let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([&format!("-{signal}"), &child.id().to_string()])
         .status()
         .unwrap();
     assert!(status.success());
@@ -356,12 +355,83 @@ fn an_interrupt_writes_the_last_complete_pass_and_exits_130() {
         start.elapsed() < Duration::from_secs(30),
         "the render stops promptly"
     );
-    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    assert_eq!(o.status.code(), Some(130), "{signal}: {}", stderr(&o));
     let err = stderr(&o);
-    assert!(err.contains("interrupted: wrote the"), "{err}");
+    assert!(err.contains("interrupted: wrote the"), "{signal}: {err}");
     let img = image::open(dir.path().join("i.png")).unwrap();
     assert_eq!((img.width(), img.height()), (32, 32));
     assert_eq!(files_in(dir.path()).len(), 1, "no temporary file left");
+}
+
+#[cfg(unix)]
+#[test]
+fn sigint_writes_the_last_complete_pass_and_exits_130() {
+    interrupt_with("INT");
+}
+
+/// What batch systems send at a job's time limit (Slurm: SIGTERM).
+#[cfg(unix)]
+#[test]
+fn sigterm_writes_the_last_complete_pass_and_exits_130() {
+    interrupt_with("TERM");
+}
+
+/// What a closed terminal or ssh session sends.
+#[cfg(unix)]
+#[test]
+fn sighup_writes_the_last_complete_pass_and_exits_130() {
+    interrupt_with("HUP");
+}
+
+/// A second signal exits at once and corrupts nothing: whether the first
+/// one had time to write the last pass or not, what is left is either no
+/// file or a whole image, never a temporary or truncated one.
+#[cfg(unix)]
+#[test]
+fn a_second_interrupt_exits_at_once_leaving_nothing() {
+    use std::time::{Duration, Instant};
+
+    let dir = tempfile::tempdir().unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_lueur"))
+        .args([
+            "render",
+            &scene("donut-mirrors"),
+            "--width",
+            "256",
+            "--height",
+            "256",
+            "--spp",
+            "1000000",
+            "--out",
+            "i.png",
+        ])
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    let kill = || {
+        let status = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(status.success());
+    };
+    kill();
+    std::thread::sleep(Duration::from_millis(100));
+    kill();
+    let start = Instant::now();
+    let o = child.wait_with_output().unwrap();
+    assert!(start.elapsed() < Duration::from_secs(10), "exits at once");
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    match files_in(dir.path()).as_slice() {
+        [] => {}
+        [one] if one.ends_with("i.png") => {
+            let img = image::open(one).expect("a whole PNG");
+            assert_eq!((img.width(), img.height()), (256, 256));
+        }
+        other => panic!("unexpected files: {other:?}"),
+    }
 }
 
 /// A render stopped at 4 spp and resumed to 8 ends bit-identical to one

@@ -1,13 +1,30 @@
-//! The film: per-pixel running statistics of the sample estimates.
+//! The film: per-pixel statistics of the sample estimates, kept so that
+//! any way of cutting a render into pieces gives the same numbers.
+//!
+//! A pixel's statistics over sample indices `a..b` are not a running
+//! (Welford) sum in index order: that order would make the result of two
+//! shards, `0..64` and `64..128`, differ in the last bits from one render
+//! of `0..128`. Instead every *dyadic block* of indices (`k 2^j ..
+//! (k+1) 2^j`) has one defined value, the merge (Chan, Golub and LeVeque
+//! 1979) of its two halves' values, down to single samples; and a film over
+//! `a..b` holds the values of the maximal dyadic blocks that tile `a..b`,
+//! largest first (at most two per bit of `b - a`; one when `a..b` is
+//! `0..2^k`). Whether the samples arrive in one pass, in pbrt's passes of
+//! 1, 1, 2, 4, ..., after a resume or from shards rendered on different
+//! machines, every block ends up with the same bits, so resuming and
+//! merging are exact. (Pairwise merging is also more accurate than a
+//! running sum, as pairwise summation is.)
+
+use std::borrow::Cow;
+use std::ops::Range;
 
 use glam::Vec3;
 
-/// Running mean and variance of one pixel's estimates (Welford 1962), per
-/// RGB channel. Welford's update stays accurate where the naive
-/// sum-of-squares formula cancels catastrophically at high spp.
+/// Mean and variance of one pixel's estimates over a set of samples, per
+/// RGB channel.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelStats {
-    /// Number of finite estimates added.
+    /// Number of finite estimates (NaN and infinite ones are dropped).
     pub n: u32,
     /// Mean of the estimates.
     pub mean: Vec3,
@@ -16,13 +33,49 @@ pub struct PixelStats {
 }
 
 impl PixelStats {
-    /// Adds one estimate. The caller has checked that it is finite.
+    /// The statistics of one estimate: a single sample if it is finite,
+    /// none if not (the caller counts the drop).
+    #[inline]
+    pub fn of_sample(x: Vec3) -> PixelStats {
+        if x.is_finite() {
+            PixelStats {
+                n: 1,
+                mean: x,
+                m2: Vec3::ZERO,
+            }
+        } else {
+            PixelStats::default()
+        }
+    }
+
+    /// The statistics of the union of two disjoint sets of samples (Chan,
+    /// Golub and LeVeque 1979, "Updating formulae and a pairwise algorithm
+    /// for computing sample variances"). Not commutative in the last bits:
+    /// `self` must be the earlier samples, so that every way of cutting a
+    /// render gives the same film.
+    #[inline]
+    pub fn merged(self, later: PixelStats) -> PixelStats {
+        if later.n == 0 {
+            return self;
+        }
+        if self.n == 0 {
+            return later;
+        }
+        let n = self.n + later.n;
+        let w_later = later.n as f32 / n as f32;
+        let delta = later.mean - self.mean;
+        PixelStats {
+            n,
+            mean: self.mean + delta * w_later,
+            m2: self.m2 + later.m2 + delta * delta * (self.n as f32 * w_later),
+        }
+    }
+
+    /// Adds one estimate at the end (Welford's update, a merge with one
+    /// sample). The caller has checked that it is finite.
     #[inline]
     pub fn add(&mut self, x: Vec3) {
-        self.n += 1;
-        let delta = x - self.mean;
-        self.mean += delta / self.n as f32;
-        self.m2 += delta * (x - self.mean);
+        *self = self.merged(PixelStats::of_sample(x));
     }
 
     /// Unbiased sample variance of one estimate (zero below two samples).
@@ -44,53 +97,291 @@ impl PixelStats {
     }
 }
 
-/// An image of per-pixel statistics, row-major, row 0 at the top.
+/// Whether `r` is a dyadic block: a power-of-two length that divides its
+/// start.
+pub fn is_dyadic(r: &Range<u32>) -> bool {
+    let len = r.end.wrapping_sub(r.start);
+    r.end > r.start && len.is_power_of_two() && r.start.is_multiple_of(len)
+}
+
+/// The maximal dyadic blocks that tile `r`, in order: the blocks a film
+/// over `r` holds.
+pub fn dyadic_blocks(r: Range<u32>) -> Vec<Range<u32>> {
+    let mut blocks = Vec::new();
+    let mut start = u64::from(r.start);
+    let end = u64::from(r.end);
+    while start < end {
+        // The largest block that starts here (its length divides `start`)
+        // and fits before `end`.
+        let align = if start == 0 {
+            1 << 32
+        } else {
+            1u64 << start.trailing_zeros()
+        };
+        let fits = 1u64 << (63 - (end - start).leading_zeros());
+        let len = align.min(fits);
+        blocks.push(start as u32..(start + len) as u32);
+        start += len;
+    }
+    blocks
+}
+
+/// Statistics of the dyadic blocks of one pixel's samples, built one sample
+/// at a time: a binary counter whose carries are merges, so that it holds
+/// [`dyadic_blocks`] of the samples pushed so far, with their defined
+/// values. Lives on the stack: 64 blocks cover any range of `u32` indices.
+pub(crate) struct BlockCounter {
+    blocks: [(Range<u32>, PixelStats); 64],
+    len: usize,
+}
+
+impl BlockCounter {
+    pub(crate) fn new() -> BlockCounter {
+        BlockCounter {
+            blocks: std::array::from_fn(|_| (0..0, PixelStats::default())),
+            len: 0,
+        }
+    }
+
+    /// Appends sample `index` (the one after the last pushed).
+    #[inline]
+    pub(crate) fn push(&mut self, index: u32, stats: PixelStats) {
+        let mut block = (index..index + 1, stats);
+        while self.len > 0 {
+            let top = &self.blocks[self.len - 1];
+            if !siblings(&top.0, &block.0) {
+                break;
+            }
+            block = (top.0.start..block.0.end, top.1.merged(block.1));
+            self.len -= 1;
+        }
+        self.blocks[self.len] = block;
+        self.len += 1;
+    }
+
+    /// Forgets every sample, to start the next pixel.
+    pub(crate) fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    /// The blocks, in order.
+    pub(crate) fn blocks(&self) -> &[(Range<u32>, PixelStats)] {
+        &self.blocks[..self.len]
+    }
+}
+
+/// Whether `a` and `b` are the two halves of one dyadic block, `a` first.
+fn siblings(a: &Range<u32>, b: &Range<u32>) -> bool {
+    let len = a.end - a.start;
+    a.end == b.start
+        && b.end - b.start == len
+        && len.is_power_of_two()
+        && u64::from(a.start).is_multiple_of(2 * u64::from(len))
+}
+
+/// One dyadic block of sample indices and every pixel's statistics over it.
+#[derive(Clone, Debug, PartialEq)]
+struct Block {
+    samples: Range<u32>,
+    pixels: Vec<PixelStats>,
+}
+
+/// Why saved or merged statistics do not make a film.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FilmError {
+    /// Films of different image sizes.
+    #[error("films of different sizes: {0}x{1} and {2}x{3}")]
+    SizeMismatch(u32, u32, u32, u32),
+    /// Sample ranges that leave a gap or overlap.
+    #[error("sample ranges do not follow each other: {0:?} then {1:?}")]
+    NotContiguous(Range<u32>, Range<u32>),
+    /// A block whose pixel count is not the image's.
+    #[error("a block holds {0} pixels, the image has {1}")]
+    PixelCount(usize, usize),
+    /// A pixel with more samples than its block, or non-finite statistics.
+    #[error("invalid statistics in block {0:?}")]
+    InvalidStats(Range<u32>),
+    /// Nothing to merge.
+    #[error("no films to merge")]
+    Empty,
+}
+
+/// An image of per-pixel statistics over a range of sample indices,
+/// row-major, row 0 at the top.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     width: u32,
     height: u32,
-    /// Sample indices `0..spp` have been added to every pixel (less any
-    /// NaN or infinite sample, dropped and counted by the render).
-    spp: u32,
-    pixels: Vec<PixelStats>,
+    /// First sample index (0 unless the film is a shard).
+    start: u32,
+    /// The [`dyadic_blocks`] of `start..end`, in order.
+    blocks: Vec<Block>,
 }
 
 impl Film {
-    /// An empty film.
+    /// An empty film, to be filled from sample index 0.
     pub fn new(width: u32, height: u32) -> Film {
+        Film::starting_at(width, height, 0)
+    }
+
+    /// An empty film to be filled from sample index `start`: a shard of a
+    /// render that other machines render the rest of.
+    pub fn starting_at(width: u32, height: u32, start: u32) -> Film {
         Film {
             width,
             height,
-            spp: 0,
-            pixels: vec![PixelStats::default(); width as usize * height as usize],
+            start,
+            blocks: Vec::new(),
         }
     }
 
-    /// Samples per pixel rendered so far: every pixel has seen sample
-    /// indices `0..spp`, so a film is always a whole number of samples per
-    /// pixel, however its render was cut into passes.
+    /// The sample indices every pixel has seen (less any NaN or infinite
+    /// sample, dropped and counted by the render): a film is always a whole
+    /// number of samples per pixel, however its render was cut.
+    pub fn samples(&self) -> Range<u32> {
+        let end = self.blocks.last().map_or(self.start, |b| b.samples.end);
+        self.start..end
+    }
+
+    /// Samples per pixel rendered so far.
     pub fn spp(&self) -> u32 {
-        self.spp
+        let r = self.samples();
+        r.end - r.start
     }
 
-    /// A film from saved statistics (a checkpoint): `pixels` row-major,
-    /// `width * height` of them, each holding at most `spp` samples.
-    /// `None` if the parts do not fit together.
-    pub fn from_parts(width: u32, height: u32, spp: u32, pixels: Vec<PixelStats>) -> Option<Film> {
-        let fits = pixels.len() == width as usize * height as usize
-            && pixels.iter().all(|p| {
-                p.n <= spp && p.mean.is_finite() && p.m2.is_finite() && p.m2.min_element() >= 0.0
-            });
-        fits.then_some(Film {
-            width,
-            height,
-            spp,
-            pixels,
-        })
+    /// Each dyadic block of samples with every pixel's statistics over it,
+    /// in order: the film's full state, what a checkpoint saves.
+    pub fn blocks(&self) -> impl Iterator<Item = (Range<u32>, &[PixelStats])> {
+        self.blocks
+            .iter()
+            .map(|b| (b.samples.clone(), b.pixels.as_slice()))
     }
 
-    pub(crate) fn set_spp(&mut self, spp: u32) {
-        self.spp = spp;
+    /// A film from saved blocks (a checkpoint or a shard): each block's
+    /// sample range and its `width * height` pixels, row-major. Refused
+    /// unless the ranges follow each other and every statistic is valid.
+    /// Blocks that are not the maximal dyadic tiling of their range (saved
+    /// by hand, say) are merged as they come: the film is still right, but
+    /// adding to it is no longer bit-identical to rendering at once.
+    pub fn from_blocks(
+        width: u32,
+        height: u32,
+        start: u32,
+        blocks: Vec<(Range<u32>, Vec<PixelStats>)>,
+    ) -> Result<Film, FilmError> {
+        let mut film = Film::starting_at(width, height, start);
+        for (samples, pixels) in blocks {
+            film.append(samples, pixels)?;
+        }
+        Ok(film)
+    }
+
+    /// Appends the statistics of the samples that follow the film's (each
+    /// pixel's, row-major), merging dyadic siblings as a binary counter
+    /// carries.
+    pub(crate) fn append(
+        &mut self,
+        samples: Range<u32>,
+        pixels: Vec<PixelStats>,
+    ) -> Result<(), FilmError> {
+        let count = self.width as usize * self.height as usize;
+        if pixels.len() != count {
+            return Err(FilmError::PixelCount(pixels.len(), count));
+        }
+        let len = samples.end.wrapping_sub(samples.start);
+        let valid = pixels.iter().all(|p| {
+            p.n <= len && p.mean.is_finite() && p.m2.is_finite() && p.m2.min_element() >= 0.0
+        });
+        if !valid {
+            return Err(FilmError::InvalidStats(samples));
+        }
+        self.check_follows(&samples)?;
+        if self.top_is_sibling_of(&samples) {
+            self.merge_into_top(samples, |i| pixels[i]);
+        } else {
+            self.blocks.push(Block { samples, pixels });
+        }
+        self.carry();
+        Ok(())
+    }
+
+    /// [`Film::append`] for a render pass, whose pixels come out of its
+    /// tiles: `pixel(i)` is pixel `i`'s statistics over `samples`. Merges in
+    /// place when it can, so the film does not briefly exist twice.
+    pub(crate) fn append_with(
+        &mut self,
+        samples: Range<u32>,
+        pixel: impl Fn(usize) -> PixelStats,
+    ) -> Result<(), FilmError> {
+        self.check_follows(&samples)?;
+        if self.top_is_sibling_of(&samples) {
+            self.merge_into_top(samples, pixel);
+        } else {
+            let count = self.width as usize * self.height as usize;
+            let pixels = (0..count).map(pixel).collect();
+            self.blocks.push(Block { samples, pixels });
+        }
+        self.carry();
+        Ok(())
+    }
+
+    fn check_follows(&self, samples: &Range<u32>) -> Result<(), FilmError> {
+        if samples.start != self.samples().end || samples.end <= samples.start {
+            return Err(FilmError::NotContiguous(self.samples(), samples.clone()));
+        }
+        Ok(())
+    }
+
+    fn top_is_sibling_of(&self, samples: &Range<u32>) -> bool {
+        self.blocks
+            .last()
+            .is_some_and(|top| siblings(&top.samples, samples))
+    }
+
+    fn merge_into_top(&mut self, samples: Range<u32>, pixel: impl Fn(usize) -> PixelStats) {
+        let top = self.blocks.last_mut().expect("checked by the caller");
+        for (i, a) in top.pixels.iter_mut().enumerate() {
+            *a = a.merged(pixel(i));
+        }
+        top.samples.end = samples.end;
+    }
+
+    /// Merges the top block into the one below while they are siblings.
+    fn carry(&mut self) {
+        while self.blocks.len() >= 2 {
+            let n = self.blocks.len();
+            if !siblings(&self.blocks[n - 2].samples, &self.blocks[n - 1].samples) {
+                break;
+            }
+            let top = self.blocks.pop().expect("two blocks");
+            self.merge_into_top(top.samples, |i| top.pixels[i]);
+        }
+    }
+
+    /// Merges films of consecutive sample ranges (shards of one render, in
+    /// any order) into one. When each shard was rendered by lueur, the
+    /// result is bit-identical to rendering their union at once.
+    pub fn merge(mut shards: Vec<Film>) -> Result<Film, FilmError> {
+        shards.sort_by_key(|f| f.start);
+        let mut shards = shards.into_iter();
+        let mut film = shards.next().ok_or(FilmError::Empty)?;
+        for shard in shards {
+            if (shard.width, shard.height) != (film.width, film.height) {
+                return Err(FilmError::SizeMismatch(
+                    film.width,
+                    film.height,
+                    shard.width,
+                    shard.height,
+                ));
+            }
+            if shard.start != film.samples().end {
+                return Err(FilmError::NotContiguous(film.samples(), shard.samples()));
+            }
+            for block in shard.blocks {
+                film.append(block.samples, block.pixels)?;
+            }
+        }
+        Ok(film)
     }
 
     /// Relative standard error of the image: the RMS over pixels and
@@ -98,12 +389,12 @@ impl Film {
     /// radiance. What `--target-error` stops on; infinite before 2 spp.
     pub fn relative_error(&self) -> f64 {
         let (mean, _) = self.image_mean();
-        if self.spp < 2 || !(mean > 0.0) {
+        if self.spp() < 2 || !(mean > 0.0) {
             return f64::INFINITY;
         }
-        let n = 3.0 * self.pixels.len() as f64;
-        let var: f64 = self
-            .pixels
+        let pixels = self.pixels();
+        let n = 3.0 * pixels.len() as f64;
+        let var: f64 = pixels
             .iter()
             .map(|p| p.variance_of_mean().element_sum() as f64)
             .sum::<f64>()
@@ -121,28 +412,44 @@ impl Film {
         self.height
     }
 
-    /// Statistics of pixel (x, y).
-    pub fn pixel(&self, x: u32, y: u32) -> &PixelStats {
-        &self.pixels[(y * self.width + x) as usize]
+    /// Statistics of pixel (x, y) over all the film's samples.
+    pub fn pixel(&self, x: u32, y: u32) -> PixelStats {
+        let i = (y * self.width + x) as usize;
+        self.blocks
+            .iter()
+            .fold(PixelStats::default(), |acc, b| acc.merged(b.pixels[i]))
     }
 
-    /// All pixels, row-major.
-    pub fn pixels(&self) -> &[PixelStats] {
-        &self.pixels
-    }
-
-    pub(crate) fn pixels_mut(&mut self) -> &mut [PixelStats] {
-        &mut self.pixels
+    /// Statistics of every pixel over all the film's samples, row-major:
+    /// the blocks merged in order (borrowed when there is one block, as
+    /// after a render of `0..2^k`).
+    pub fn pixels(&self) -> Cow<'_, [PixelStats]> {
+        match self.blocks.as_slice() {
+            [] => Cow::Owned(vec![
+                PixelStats::default();
+                self.width as usize * self.height as usize
+            ]),
+            [one] => Cow::Borrowed(&one.pixels),
+            [first, rest @ ..] => {
+                let mut acc = first.pixels.clone();
+                for b in rest {
+                    for (a, p) in acc.iter_mut().zip(&b.pixels) {
+                        *a = a.merged(*p);
+                    }
+                }
+                Cow::Owned(acc)
+            }
+        }
     }
 
     /// Mean radiance of every pixel, row-major.
     pub fn mean_image(&self) -> Vec<Vec3> {
-        self.pixels.iter().map(|p| p.mean).collect()
+        self.pixels().iter().map(|p| p.mean).collect()
     }
 
     /// Variance of the mean of every pixel, row-major.
     pub fn variance_image(&self) -> Vec<Vec3> {
-        self.pixels.iter().map(|p| p.variance_of_mean()).collect()
+        self.pixels().iter().map(|p| p.variance_of_mean()).collect()
     }
 
     /// The mean image as 8-bit sRGB (IEC 61966-2-1), clamped, after scaling
@@ -158,7 +465,7 @@ impl Film {
             };
             (v * 255.0 + 0.5) as u8
         };
-        self.pixels
+        self.pixels()
             .iter()
             .flat_map(|p| [encode(p.mean.x), encode(p.mean.y), encode(p.mean.z)])
             .collect()
@@ -167,26 +474,25 @@ impl Film {
     /// Mean over pixels and channels of the per-sample variance: the noise
     /// of one sample, the figure the strategies are compared on.
     pub fn mean_sample_variance(&self) -> f64 {
-        let sum: f64 = self
-            .pixels
+        let pixels = self.pixels();
+        let sum: f64 = pixels
             .iter()
             .map(|p| p.sample_variance().element_sum() as f64)
             .sum();
-        sum / (3.0 * self.pixels.len() as f64)
+        sum / (3.0 * pixels.len() as f64)
     }
 
     /// Mean of the image over pixels and channels, with its standard error
     /// (pixels are independent, so the variances of their means add).
     pub fn image_mean(&self) -> (f64, f64) {
-        let n = 3.0 * self.pixels.len() as f64;
-        let mean: f64 = self
-            .pixels
+        let pixels = self.pixels();
+        let n = 3.0 * pixels.len() as f64;
+        let mean: f64 = pixels
             .iter()
             .map(|p| p.mean.element_sum() as f64)
             .sum::<f64>()
             / n;
-        let var: f64 = self
-            .pixels
+        let var: f64 = pixels
             .iter()
             .map(|p| p.variance_of_mean().element_sum() as f64)
             .sum::<f64>()
@@ -214,9 +520,115 @@ mod tests {
     }
 
     #[test]
+    fn pairwise_merge_matches_two_pass() {
+        let xs: Vec<f32> = (0..37)
+            .map(|i| ((i * 7919) % 101) as f32 * 0.37 - 9.0)
+            .collect();
+        let mut counter = BlockCounter::new();
+        for (i, &x) in xs.iter().enumerate() {
+            counter.push(i as u32, PixelStats::of_sample(Vec3::splat(x)));
+        }
+        let ranges: Vec<_> = counter.blocks().iter().map(|b| b.0.clone()).collect();
+        assert_eq!(ranges, dyadic_blocks(0..37));
+        let s = counter
+            .blocks()
+            .iter()
+            .fold(PixelStats::default(), |a, b| a.merged(b.1));
+        let mean = xs.iter().map(|&x| f64::from(x)).sum::<f64>() / xs.len() as f64;
+        let var = xs
+            .iter()
+            .map(|&x| (f64::from(x) - mean).powi(2))
+            .sum::<f64>()
+            / (xs.len() - 1) as f64;
+        assert_eq!(s.n, 37);
+        assert!((f64::from(s.mean.x) - mean).abs() < 1e-5 * mean.abs().max(1.0));
+        assert!((f64::from(s.sample_variance().x) - var).abs() < 1e-5 * var);
+    }
+
+    #[test]
+    fn dropped_samples_do_not_count() {
+        let mut s = PixelStats::of_sample(Vec3::new(f32::NAN, 0.0, 0.0));
+        assert_eq!(s.n, 0);
+        s = s.merged(PixelStats::of_sample(Vec3::ONE));
+        s = s.merged(PixelStats::of_sample(Vec3::splat(f32::INFINITY)));
+        assert_eq!((s.n, s.mean), (1, Vec3::ONE));
+    }
+
+    #[test]
     fn one_sample_has_no_variance() {
         let mut s = PixelStats::default();
         s.add(Vec3::ONE);
         assert_eq!(s.variance_of_mean(), Vec3::ZERO);
+    }
+
+    #[test]
+    fn dyadic_blocks_tile_any_range() {
+        assert_eq!(dyadic_blocks(0..100), vec![0..64, 64..96, 96..100]);
+        assert_eq!(dyadic_blocks(64..128), vec![64..128]);
+        assert_eq!(dyadic_blocks(3..13), vec![3..4, 4..8, 8..12, 12..13]);
+        assert_eq!(dyadic_blocks(0..u32::MAX).len(), 32);
+        assert!(dyadic_blocks(5..5).is_empty());
+        for a in 0..70u32 {
+            for b in a..70 {
+                let blocks = dyadic_blocks(a..b);
+                let mut at = a;
+                for r in &blocks {
+                    assert!(is_dyadic(r), "{r:?}");
+                    assert_eq!(r.start, at);
+                    at = r.end;
+                }
+                assert_eq!(at, b);
+                // Maximal: no two neighbours are the halves of one block.
+                assert!(blocks.windows(2).all(|w| !siblings(&w[0], &w[1])));
+            }
+        }
+    }
+
+    fn film_of(samples: Range<u32>, value: impl Fn(u32) -> f32) -> Film {
+        let mut film = Film::starting_at(1, 1, samples.start);
+        for r in dyadic_blocks(samples) {
+            let mut counter = BlockCounter::new();
+            for i in r.clone() {
+                counter.push(i, PixelStats::of_sample(Vec3::splat(value(i))));
+            }
+            for (range, stats) in counter.blocks() {
+                film.append(range.clone(), vec![*stats]).unwrap();
+            }
+        }
+        film
+    }
+
+    #[test]
+    fn any_cut_gives_the_same_bits() {
+        let value = |i: u32| (i as f32 * 0.618_034).fract() * 10.0 + 1e3;
+        let whole = film_of(0..100, value);
+        assert_eq!(whole.blocks().count(), 3);
+        for cut in [1, 37, 64, 65, 99] {
+            let parts = vec![film_of(cut..100, value), film_of(0..cut, value)];
+            let merged = Film::merge(parts).unwrap();
+            assert_eq!(merged, whole, "cut at {cut}");
+        }
+        let three = Film::merge(vec![
+            film_of(0..10, value),
+            film_of(10..50, value),
+            film_of(50..100, value),
+        ])
+        .unwrap();
+        assert_eq!(three, whole);
+    }
+
+    #[test]
+    fn merge_refuses_gaps_and_overlaps() {
+        let v = |_| 1.0;
+        let gap = Film::merge(vec![film_of(0..8, v), film_of(9..16, v)]);
+        assert!(matches!(gap, Err(FilmError::NotContiguous(..))));
+        let overlap = Film::merge(vec![film_of(0..8, v), film_of(4..16, v)]);
+        assert!(matches!(overlap, Err(FilmError::NotContiguous(..))));
+        assert_eq!(Film::merge(vec![]), Err(FilmError::Empty));
+        let other_size = Film::starting_at(2, 1, 8);
+        assert!(matches!(
+            Film::merge(vec![film_of(0..8, v), other_size]),
+            Err(FilmError::SizeMismatch(..))
+        ));
     }
 }

@@ -51,7 +51,7 @@ mod scene;
 mod strategy;
 
 pub use camera::Camera;
-pub use film::{Film, PixelStats};
+pub use film::{Film, FilmError, PixelStats, dyadic_blocks, is_dyadic};
 pub use path::RayCounters;
 pub use render::{RenderOutput, RenderSettings, RenderStats, render, render_pass};
 pub use scene::{Hit, Light, Marching, Object, QuadSampling, Scene, TraceCounters};

@@ -8,7 +8,7 @@ use glam::UVec2;
 use lueur_sampling::{Sampler, SamplerKind};
 use rayon::prelude::*;
 
-use crate::film::{Film, PixelStats};
+use crate::film::{BlockCounter, Film, PixelStats, dyadic_blocks};
 use crate::path::{CAMERA_DIMS, Estimator, March, RayCounters, SampleId, radiance};
 use crate::{RenderError, Scene, Strategy};
 
@@ -156,7 +156,8 @@ pub struct RenderOutput {
 /// Runs on the current rayon thread pool: wrap the call in
 /// `ThreadPool::install` to choose the thread count. The image does not
 /// depend on it: each random number depends only on (pixel, sample index,
-/// dimension, seed), and each pixel adds its samples in index order.
+/// dimension, seed), and each pixel merges its samples in a fixed tree (see
+/// [`crate::film`]).
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
@@ -175,10 +176,15 @@ pub fn render(
     Ok(RenderOutput { film, stats })
 }
 
-/// Adds sample indices `film.spp()..until` to every pixel of `film`: one
-/// pass of a progressive render. Because each pixel adds its samples in
-/// index order, rendering `0..4` then `4..8` gives the bit-identical film
-/// of rendering `0..8` at once.
+/// Adds sample indices `film.samples().end..until` to every pixel of
+/// `film`: one pass of a progressive render, or one shard's part of a
+/// render (a film made by [`Film::starting_at`]). Every way of cutting
+/// `0..spp` into passes and shards gives the bit-identical film (see the
+/// [`crate::film`] module), and the image does not depend on the thread
+/// count either.
+///
+/// `settings.spp` is the spp of the whole render: some samplers lay their
+/// patterns out over it, so shards must share it; `until` may not pass it.
 ///
 /// `cancel` is polled before every pixel; once it is set the pass is
 /// abandoned, `film` is left exactly as it was (still a whole number of
@@ -198,7 +204,7 @@ pub fn render_pass(
             "the film's size differs from the settings'",
         ));
     }
-    let from = film.spp();
+    let from = film.samples().end;
     if until <= from || until > settings.spp {
         return Err(RenderError::InvalidSetting(
             "a pass must add samples, and stop at or before the render's spp",
@@ -210,45 +216,56 @@ pub fn render_pass(
         settings,
         march: March::new(scene, settings),
     };
+    let tiles_x = w.div_ceil(TILE);
     let tiles: Vec<UVec2> = (0..h.div_ceil(TILE))
-        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| UVec2::new(tx * TILE, ty * TILE)))
+        .flat_map(|ty| (0..tiles_x).map(move |tx| UVec2::new(tx * TILE, ty * TILE)))
         .collect();
 
-    let existing: &Film = film;
     let results: Vec<Option<TileResult>> = tiles
         .par_iter()
         .map(|&origin| {
-            let r = render_tile(&estimator, existing, origin, from..until, cancel)?;
-            progress(r.pixels.len() as u64 * u64::from(until - from));
+            let r = render_tile(&estimator, origin, from..until, cancel)?;
+            progress(u64::from(r.width * r.height) * u64::from(until - from));
             Some(r)
         })
         .collect();
     if cancel.load(Ordering::Relaxed) || results.iter().any(Option::is_none) {
         return Ok(None);
     }
+    let results: Vec<TileResult> = results.into_iter().flatten().collect();
 
     let mut stats = RenderStats::default();
-    let pixels = film.pixels_mut();
-    for r in results.into_iter().flatten() {
-        let tw = (w - r.origin.x).min(TILE);
-        for (i, px) in r.pixels.into_iter().enumerate() {
-            let (x, y) = (r.origin.x + i as u32 % tw, r.origin.y + i as u32 / tw);
-            let slot = &mut pixels[(y * w + x) as usize];
-            stats.samples += u64::from(px.n - slot.n);
-            *slot = px;
-        }
+    for r in &results {
         stats.rays.merge(&r.counters);
         stats.dropped_samples += r.dropped;
+        stats.samples += r
+            .blocks
+            .iter()
+            .flatten()
+            .map(|p| u64::from(p.n))
+            .sum::<u64>();
     }
-    film.set_spp(until);
+    for (j, samples) in dyadic_blocks(from..until).into_iter().enumerate() {
+        // Results are in tile order, each tile row-major.
+        let pixel = |i: usize| {
+            let (x, y) = (i as u32 % w, i as u32 / w);
+            let r = &results[((y / TILE) * tiles_x + x / TILE) as usize];
+            r.blocks[j][((y % TILE) * r.width + x % TILE) as usize]
+        };
+        film.append_with(samples, pixel)
+            .expect("a pass's blocks follow the film's");
+    }
     stats.elapsed = start.elapsed();
     Ok(Some(stats))
 }
 
-/// One tile's pixels after a pass, and what the pass cost there.
+/// One tile's statistics after a pass, and what the pass cost there.
 struct TileResult {
-    origin: UVec2,
-    pixels: Vec<PixelStats>,
+    width: u32,
+    height: u32,
+    /// Per dyadic block of the pass's samples, the tile's pixels over it,
+    /// row-major.
+    blocks: Vec<Vec<PixelStats>>,
     counters: RayCounters,
     dropped: u64,
 }
@@ -256,7 +273,6 @@ struct TileResult {
 /// `None` when cancelled.
 fn render_tile(
     estimator: &Estimator<'_>,
-    film: &Film,
     origin: UVec2,
     samples: Range<u32>,
     cancel: &AtomicBool,
@@ -267,13 +283,15 @@ fn render_tile(
     let mut sampler = Sampler::for_image(settings.sampler, settings.seed, [w, h], settings.spp);
     let mut counters = RayCounters::default();
     let mut dropped = 0u64;
-    let mut pixels = Vec::with_capacity((tw * th) as usize);
+    let block_count = dyadic_blocks(samples.clone()).len();
+    let mut blocks = vec![Vec::with_capacity((tw * th) as usize); block_count];
+    let mut counter = BlockCounter::new();
     for y in origin.y..origin.y + th {
         for x in origin.x..origin.x + tw {
             if cancel.load(Ordering::Relaxed) {
                 return None;
             }
-            let mut stats = *film.pixel(x, y);
+            counter.clear();
             for index in samples.clone() {
                 let id = SampleId {
                     pixel: [x, y],
@@ -285,18 +303,21 @@ fn render_tile(
                 let film_point = glam::Vec2::new(x as f32, y as f32) + jitter;
                 let ray = estimator.scene.camera.generate_ray(film_point, w, h);
                 let l = radiance(estimator, ray, &mut sampler, id, &mut counters);
-                if l.is_finite() {
-                    stats.add(l);
-                } else {
+                if !l.is_finite() {
                     dropped += 1;
                 }
+                counter.push(index, PixelStats::of_sample(l));
             }
-            pixels.push(stats);
+            debug_assert_eq!(counter.blocks().len(), block_count);
+            for (block, (_, stats)) in blocks.iter_mut().zip(counter.blocks()) {
+                block.push(*stats);
+            }
         }
     }
     Some(TileResult {
-        origin,
-        pixels,
+        width: tw,
+        height: th,
+        blocks,
         counters,
         dropped,
     })

@@ -100,6 +100,17 @@ impl SamplerKind {
         SamplerKind::Pmj02,
     ];
 
+    /// Whether a sample's value depends on the render's total spp: the
+    /// patterns laid out over `spp` points (stratified, Latin hypercube,
+    /// CMJ) and ZSobol's Morton index. Such a render can only be resumed or
+    /// sharded with the same total spp; the sequences can be extended.
+    pub fn depends_on_spp(&self) -> bool {
+        matches!(
+            self,
+            SamplerKind::Stratified | SamplerKind::Lhs | SamplerKind::Cmj | SamplerKind::ZSobol
+        )
+    }
+
     /// The lowercase name used on command lines and in scene files.
     pub fn name(&self) -> &'static str {
         match self {
@@ -551,6 +562,27 @@ const R2_INCREMENTS: [u64; 2] = [0xc13f_a9a9_02a6_328f, 0x91e1_0da5_c79e_7b1c];
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn depends_on_spp_says_which_kinds_change_with_the_total() {
+        // Resumed and sharded renders rely on it: a kind that claims not to
+        // depend on the total spp must give the same values for the first
+        // 16 samples of a 16-spp and of a 64-spp render.
+        for &kind in SamplerKind::ALL {
+            let values = |spp: u32| {
+                let mut s = Sampler::for_image(kind, 5, [8, 8], spp);
+                let mut v = Vec::new();
+                for index in 0..16 {
+                    s.start_pixel_sample([3, 5], index, 0);
+                    v.push(s.next_2d());
+                    v.push(Vec2::splat(s.next_1d()));
+                }
+                v
+            };
+            let same = values(16) == values(64);
+            assert_eq!(same, !kind.depends_on_spp(), "{kind}");
+        }
+    }
 
     #[test]
     fn names_round_trip() {
