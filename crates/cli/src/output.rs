@@ -4,8 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use glam::Vec3;
-use lueur_integrator::Film;
+use lueur_integrator::{Film, PixelStats};
 
 /// Image formats, chosen by the output's extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -70,22 +69,22 @@ fn write_png(path: &Path, film: &Film, exposure: f32) -> Result<()> {
 
 fn write_exr(path: &Path, film: &Film) -> Result<()> {
     use exr::prelude::*;
-    let channel = |name: &str, f: &dyn Fn(Vec3) -> f32, image: &[Vec3]| {
-        AnyChannel::new(
-            name,
-            FlatSamples::F32(image.iter().map(|&v| f(v)).collect()),
-        )
-    };
-    let mean = film.mean_image();
-    let var = film.variance_image();
-    let channels = AnyChannels::sort(SmallVec::from_vec(vec![
-        channel("R", &|v| v.x, &mean),
-        channel("G", &|v| v.y, &mean),
-        channel("B", &|v| v.z, &mean),
-        channel("variance.R", &|v| v.x, &var),
-        channel("variance.G", &|v| v.y, &var),
-        channel("variance.B", &|v| v.z, &var),
-    ]));
+    // Pixels are read straight from the film's statistics as the writer
+    // asks for them, so a 4K film is not copied into channel images first.
+    let pixels = film.pixels();
+    let width = film.width() as usize;
+    let channels = SpecificChannels::build()
+        .with_channel("R")
+        .with_channel("G")
+        .with_channel("B")
+        .with_channel("variance.R")
+        .with_channel("variance.G")
+        .with_channel("variance.B")
+        .with_pixel_fn(|pos: Vec2<usize>| {
+            let p: &PixelStats = &pixels[pos.y() * width + pos.x()];
+            let v = p.variance_of_mean();
+            (p.mean.x, p.mean.y, p.mean.z, v.x, v.y, v.z)
+        });
     let size = (film.width() as usize, film.height() as usize);
     let layer = Layer::new(
         size,
