@@ -19,3 +19,6 @@ mod strategies;
 
 // Degenerate but valid scenes, and the same scene scaled and moved far away.
 mod degenerate;
+
+// The fast marching against the naive reference: the same images.
+mod marching;

@@ -51,7 +51,7 @@ pub use glam::{Quat, Vec3};
 
 pub use crate::blend::{smooth_max, smooth_min};
 pub use crate::field::DistanceField;
-pub use crate::normal::{FALLBACK_NORMAL, gradient, normal, normal_central};
+pub use crate::normal::{FALLBACK_NORMAL, gradient, gradient_central, normal, normal_central};
 pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
 pub use crate::trace::{

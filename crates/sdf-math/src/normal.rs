@@ -41,6 +41,14 @@ pub fn gradient<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
         / (4.0 * h)
 }
 
+/// The gradient by central differences (6 evaluations), not normalised: the naive
+/// reference for [`gradient`], with the same treatment of `h` and the same caveat.
+pub fn gradient_central<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
+    let h = usable_step(p, h);
+    let d = |e: Vec3| field.distance(p + e * h) - field.distance(p - e * h);
+    Vec3::new(d(Vec3::X), d(Vec3::Y), d(Vec3::Z)) / (2.0 * h)
+}
+
 /// Central differences (6 evaluations), kept as the naive reference for [`normal`].
 ///
 /// Same guarantees and the same treatment of `h` as [`normal`].
@@ -117,6 +125,34 @@ mod tests {
             let expected = Vec3::new(0.6, 0.0, 0.8);
             assert!((normal(&field, Vec3::ONE, 1e-2) - expected).length() < 1e-3);
             assert!((normal_central(&field, Vec3::ONE, 1e-2) - expected).length() < 1e-3);
+        }
+    }
+
+    #[test]
+    fn both_gradients_are_exact_on_linear_fields_at_any_offset() {
+        // A linear field has the same gradient everywhere: both difference
+        // schemes must return it, not a multiple, near and far from the
+        // origin (where h is raised to a few ulps of p).
+        struct Linear(Vec3);
+        impl DistanceField for Linear {
+            fn distance(&self, p: Vec3) -> f32 {
+                p.dot(self.0)
+            }
+            fn lipschitz(&self) -> f32 {
+                self.0.length()
+            }
+        }
+        let g = Vec3::new(0.36, -0.48, 0.8);
+        for p in [Vec3::ZERO, Vec3::ONE, Vec3::splat(1e3)] {
+            for grad in [
+                gradient(&Linear(g), p, 1e-2),
+                gradient_central(&Linear(g), p, 1e-2),
+            ] {
+                assert!(
+                    (grad - g).length() < 1e-3 * (1.0 + p.length() * 1e-2),
+                    "{p}: {grad}"
+                );
+            }
         }
     }
 
