@@ -1,6 +1,6 @@
 //! `lueur render --stats`: what a render measured about itself, as a table.
 
-use lueur_integrator::RenderOutput;
+use lueur_integrator::{RenderOutput, STEP_BUCKETS};
 
 /// Prints the statistics of a finished render to standard output.
 pub fn print_stats(out: &RenderOutput) {
@@ -27,5 +27,17 @@ pub fn print_stats(out: &RenderOutput) {
             100.0 * c.misses as f64 / rays,
             100.0 * c.gave_up as f64 / rays,
         );
+        // Steps per ray as a histogram in powers of two: where the marching
+        // budget goes (a long tail means grazing rays near surfaces).
+        let mut line = String::from("        steps/ray");
+        for (i, &count) in c.steps_histogram.iter().enumerate() {
+            let label = match i {
+                0 => "1".to_string(),
+                i if i == STEP_BUCKETS - 1 => format!("{}+", 1u32 << i),
+                i => format!("{}-{}", 1u32 << i, (2u32 << i) - 1),
+            };
+            line.push_str(&format!("  {label}: {:.1}%", 100.0 * count as f64 / rays));
+        }
+        println!("{line}");
     }
 }

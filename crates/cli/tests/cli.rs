@@ -488,3 +488,51 @@ fn checkpoint_then_resume_equals_one_uninterrupted_render() {
     assert!(refused("donut-mirrors", &["--seed", "5"]).contains("other settings"));
     assert!(refused("cornell-spheres", &[]).contains("different scene"));
 }
+
+/// `--stats` prints per kind of ray the counts and a histogram of steps per
+/// ray whose shares add up to all the rays.
+#[test]
+fn stats_print_rays_and_a_steps_histogram() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = lueur(
+        &[
+            "render",
+            &scene("death-star"),
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--spp",
+            "4",
+            "--stats",
+            "-o",
+            "s.png",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8(o.stdout).unwrap();
+    for kind in ["camera", "bounce", "shadow"] {
+        assert!(out.contains(&format!("{kind:<7} rays")), "{out}");
+    }
+    let histograms: Vec<&str> = out
+        .lines()
+        .filter(|l| l.contains("steps/ray  1:"))
+        .collect();
+    assert_eq!(histograms.len(), 3, "{out}");
+    for line in histograms {
+        let total: f64 = line
+            .split(": ")
+            .skip(1)
+            .map(|part| {
+                part.split('%')
+                    .next()
+                    .unwrap()
+                    .trim()
+                    .parse::<f64>()
+                    .unwrap()
+            })
+            .sum();
+        assert!((total - 100.0).abs() < 1.0, "{line}");
+    }
+}

@@ -308,12 +308,22 @@ pub struct TraceCounters {
     pub misses: u64,
     /// Rays stopped by the step cap (counted as hits).
     pub gave_up: u64,
+    /// Rays by steps taken, in powers of two: bucket `i` counts rays of
+    /// `2^i ..= 2^(i+1) - 1` steps (bucket 0 also counts rays of 0 steps,
+    /// the last one every ray of 512 steps or more).
+    pub steps_histogram: [u64; STEP_BUCKETS],
 }
+
+/// Buckets of [`TraceCounters::steps_histogram`].
+pub const STEP_BUCKETS: usize = 10;
 
 impl TraceCounters {
     fn record(&mut self, outcome: &TraceOutcome) {
         self.rays += 1;
-        self.steps += outcome.steps() as u64;
+        let steps = outcome.steps() as u64;
+        self.steps += steps;
+        let bucket = (u64::BITS - 1).saturating_sub(steps.max(1).leading_zeros()) as usize;
+        self.steps_histogram[bucket.min(STEP_BUCKETS - 1)] += 1;
         match outcome {
             TraceOutcome::Hit { .. } => self.hits += 1,
             TraceOutcome::Miss { .. } => self.misses += 1,
@@ -328,6 +338,9 @@ impl TraceCounters {
         self.hits += o.hits;
         self.misses += o.misses;
         self.gave_up += o.gave_up;
+        for (a, b) in self.steps_histogram.iter_mut().zip(&o.steps_histogram) {
+            *a += b;
+        }
     }
 }
 
