@@ -36,7 +36,7 @@ pub fn settings_fingerprint(s: &RenderSettings, naive: bool) -> String {
         String::new()
     };
     format!(
-        "width={} height={} strategy={} sampler={} seed={} max_depth={} max_steps={} \
+        "width={} height={} strategy={} sampler={} seed={} max_depth={} roulette_depth={} max_steps={} \
          pixel_epsilon={} epsilon={} epsilon_abs={} naive={naive}{spp}",
         s.width,
         s.height,
@@ -44,6 +44,7 @@ pub fn settings_fingerprint(s: &RenderSettings, naive: bool) -> String {
         s.sampler,
         s.seed,
         s.max_depth,
+        s.roulette_depth,
         s.max_steps,
         s.pixel_epsilon,
         s.epsilon_rel,

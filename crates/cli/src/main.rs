@@ -86,6 +86,10 @@ struct RenderArgs {
     /// Maximum number of scattering events (0: only emitters seen directly).
     #[arg(long)]
     max_depth: Option<u32>,
+    /// Scattering events after which Russian roulette may end paths
+    /// (default 3; at max_depth or above, never).
+    #[arg(long)]
+    roulette_depth: Option<u32>,
     /// Image width in pixels.
     #[arg(long)]
     width: Option<u32>,
@@ -481,6 +485,9 @@ fn apply_flags(mut s: RenderSettings, a: &RenderArgs) -> Result<RenderSettings> 
     }
     if let Some(v) = a.max_depth {
         s.max_depth = v;
+    }
+    if let Some(v) = a.roulette_depth {
+        s.roulette_depth = v;
     }
     if let Some(v) = a.width {
         s.width = v;

@@ -17,9 +17,6 @@ pub(crate) const DIMS_PER_VERTEX: u32 = 8;
 /// mixture choice (1), BSDF direction (2), Russian roulette (1), unused (1).
 pub(crate) const CAMERA_DIMS: u32 = 2;
 
-/// Bounces after which Russian roulette may end a path.
-const ROULETTE_DEPTH: u32 = 3;
-
 /// Counters per kind of ray.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RayCounters {
@@ -389,7 +386,7 @@ pub(crate) fn radiance(
         // Russian roulette (pbrt-v4 style): unbiased, since survivors are
         // reweighted by 1 / (1 - q).
         let max_beta = beta.max_element();
-        if depth >= ROULETTE_DEPTH && max_beta < 1.0 {
+        if depth >= settings.roulette_depth && max_beta < 1.0 {
             let q = (1.0 - max_beta).max(0.0);
             if u_roulette < q {
                 break;

@@ -39,6 +39,10 @@ pub struct RenderSettings {
     pub sampler: SamplerKind,
     /// Maximum number of scattering events (0: emitters seen directly).
     pub max_depth: u32,
+    /// Scattering events after which Russian roulette may end a path (on
+    /// the throughput's largest component; unbiased, it trades noise for
+    /// time). At `max_depth` or above it never plays.
+    pub roulette_depth: u32,
     /// Seed of every random number of the render.
     pub seed: u64,
     /// Step cap of the sphere tracer.
@@ -61,6 +65,7 @@ impl Default for RenderSettings {
             strategy: Strategy::default(),
             sampler: SamplerKind::Independent,
             max_depth: 8,
+            roulette_depth: 3,
             seed: 0,
             max_steps: 256,
             pixel_epsilon: 0.25,

@@ -199,6 +199,7 @@ fn parse_render(
             "strategy",
             "sampler",
             "max_depth",
+            "roulette_depth",
             "seed",
             "max_steps",
             "pixel_epsilon",
@@ -237,6 +238,9 @@ fn parse_render(
     }
     if let Some(d) = render.u32_in(src, "max_depth", 0, 10_000)? {
         settings.max_depth = d;
+    }
+    if let Some(d) = render.u32_in(src, "roulette_depth", 0, 10_000)? {
+        settings.roulette_depth = d;
     }
     if let Some((seed, _)) = render.u64(src, "seed")? {
         settings.seed = seed;
