@@ -159,6 +159,17 @@ fn bad_shards_are_refused_with_the_files_named() {
         &["merge", "a.exr", "nowhere.exr", "-o", "m.png"],
         "nowhere.exr",
     );
+    // An image is not a film state; neither is a file that is not an EXR.
+    render(d, &["--spp", "8", "--out", "image.exr"]);
+    refused(
+        &["merge", "a.exr", "image.exr", "-o", "m.png"],
+        "not a lueur checkpoint",
+    );
+    std::fs::write(d.join("junk.exr"), b"not an exr").unwrap();
+    refused(
+        &["merge", "junk.exr", "-o", "m.png"],
+        "cannot read checkpoint junk.exr",
+    );
     let scene = donut();
     refused(
         &[
