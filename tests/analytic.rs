@@ -9,6 +9,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 use lueur::integrator::{Camera, Light, QuadSampling, RenderSettings, Strategy};
 use lueur::materials::Material;
+use lueur::sampling::SamplerKind;
 use lueur::sdf_math::{Quat, Sdf};
 
 use crate::common::{run, scene_of};
@@ -49,6 +50,7 @@ fn white_furnace_is_uniformly_one() {
     let scene = scene_of(furnace_objects(), white, vec![], Some(Vec3::ONE), camera);
     for strategy in UNBIASED {
         let settings = RenderSettings {
+            sampler: SamplerKind::Independent,
             width: 24,
             height: 16,
             spp: 256,
@@ -89,6 +91,7 @@ fn russian_roulette_is_unbiased_and_saves_rays() {
     let scene = scene_of(furnace_objects(), grey, vec![], Some(Vec3::ONE), camera);
     let render = |roulette_depth: u32, seed: u64| {
         let settings = RenderSettings {
+            sampler: SamplerKind::Independent,
             width: 24,
             height: 16,
             spp: 256,
@@ -180,6 +183,7 @@ fn direct_light_mismatches(
     // With one scattering event, `light` sees everything there is to see.
     for strategy in Strategy::ALL {
         let settings = RenderSettings {
+            sampler: SamplerKind::Independent,
             width: 2,
             height: 2,
             spp: 1 << 15,

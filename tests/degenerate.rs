@@ -8,6 +8,7 @@
 use glam::Vec3;
 use lueur::integrator::{Camera, Light, RenderOutput, RenderSettings, SceneError, Strategy};
 use lueur::materials::Material;
+use lueur::sampling::SamplerKind;
 use lueur::scene::{SceneFile, SceneFileError, parse_scene};
 use lueur::sdf_math::Sdf;
 
@@ -218,6 +219,7 @@ fn camera_inside_an_object_renders() {
     for strategy in ALL {
         for max_depth in [0, 8] {
             let settings = RenderSettings {
+                sampler: SamplerKind::Independent,
                 width: 8,
                 height: 8,
                 spp: 4,
@@ -262,6 +264,7 @@ fn light_inside_a_closed_object_is_hidden() {
     let scene = scene_of(objects, white, vec![light], None, camera);
     for strategy in ALL {
         let settings = RenderSettings {
+            sampler: SamplerKind::Independent,
             width: 8,
             height: 8,
             spp: 8,
@@ -350,6 +353,7 @@ fn tiny_images_and_sample_counts_render() {
     let file = parse(&similar_scene(Frame::IDENTITY, 1, 1));
     for (w, h, spp) in [(1, 1, 1), (1, 1, 2), (16, 16, 1), (16, 16, 2), (3, 1, 2)] {
         let settings = RenderSettings {
+            sampler: SamplerKind::Independent,
             width: w,
             height: h,
             spp,

@@ -9,6 +9,7 @@
 //! shaded wrong over a region of a few pixels moves its mean by far more.
 
 use lueur::integrator::{Film, Marching, RenderSettings, Strategy};
+use lueur::sampling::SamplerKind;
 
 use crate::common::{SHIPPED, run, shipped};
 
@@ -19,6 +20,7 @@ fn render(name: &str, marching: Marching, seed: u64) -> Film {
     let mut file = shipped(name);
     file.scene.marching = marching;
     let settings = RenderSettings {
+        sampler: SamplerKind::Independent,
         width: SIZE,
         height: SIZE,
         spp: 256,

@@ -3,12 +3,14 @@
 //! (two-sided p ~ 6e-5 per comparison for normal means).
 
 use lueur::integrator::{Film, RenderSettings, Strategy};
+use lueur::sampling::SamplerKind;
 
 use crate::common::{SHIPPED, run, shipped};
 
 fn render(name: &str, strategy: Strategy, size: u32, spp: u32) -> Film {
     let file = shipped(name);
     let settings = RenderSettings {
+        sampler: SamplerKind::Independent,
         width: size,
         height: size,
         spp,

@@ -2,7 +2,11 @@
 //!
 //! Statistical tests state their confidence next to their threshold and use
 //! fixed seeds, so they are reproducible; each would fail on a real bias of
-//! a few percent (see `analytic::a_wrong_pdf_is_caught`).
+//! a few percent (see `analytic::a_wrong_answer_is_caught`). They render
+//! with independent samples whatever the default sampler: a film's standard
+//! error (sample variance / n) is the true error of the mean only for them;
+//! for low-discrepancy points it overestimates it, and the z-tests would
+//! lose their power.
 
 mod common;
 

@@ -63,7 +63,7 @@ impl Default for RenderSettings {
             height: 256,
             spp: 64,
             strategy: Strategy::default(),
-            sampler: SamplerKind::Independent,
+            sampler: SamplerKind::default(),
             max_depth: 8,
             roulette_depth: 3,
             seed: 0,
