@@ -7,8 +7,8 @@
 use font8x8::UnicodeFonts;
 use image::{Rgb, RgbImage};
 
-const BACKGROUND: Rgb<u8> = Rgb([255, 255, 255]);
-const INK: Rgb<u8> = Rgb([20, 20, 20]);
+pub const BACKGROUND: Rgb<u8> = Rgb([255, 255, 255]);
+pub const INK: Rgb<u8> = Rgb([20, 20, 20]);
 /// Glyphs are 8x8, drawn at this integer scale.
 const TEXT_SCALE: u32 = 2;
 const PAD: u32 = 6;
@@ -17,6 +17,19 @@ const LABEL_HEIGHT: u32 = 8 * TEXT_SCALE + 2 * PAD;
 /// Draws `text` with its top-left corner at (x, y); characters outside
 /// Basic Latin are skipped.
 pub fn draw_text(img: &mut RgbImage, x: u32, y: u32, text: &str, color: Rgb<u8>) {
+    draw_text_scaled(img, x, y, text, color, TEXT_SCALE);
+}
+
+/// [`draw_text`] with the glyphs drawn at `scale` (1: 8x8 pixels), for
+/// tick labels where the default size does not fit.
+pub fn draw_text_scaled(
+    img: &mut RgbImage,
+    x: u32,
+    y: u32,
+    text: &str,
+    color: Rgb<u8>,
+    scale: u32,
+) {
     let mut cx = x;
     for ch in text.chars() {
         if let Some(glyph) = font8x8::BASIC_FONTS.get(ch) {
@@ -24,10 +37,9 @@ pub fn draw_text(img: &mut RgbImage, x: u32, y: u32, text: &str, color: Rgb<u8>)
                 for col in 0..8u32 {
                     // font8x8 stores the leftmost pixel in the lowest bit.
                     if bits >> col & 1 == 1 {
-                        for dy in 0..TEXT_SCALE {
-                            for dx in 0..TEXT_SCALE {
-                                let (px, py) =
-                                    (cx + col * TEXT_SCALE + dx, y + row as u32 * TEXT_SCALE + dy);
+                        for dy in 0..scale {
+                            for dx in 0..scale {
+                                let (px, py) = (cx + col * scale + dx, y + row as u32 * scale + dy);
                                 if px < img.width() && py < img.height() {
                                     img.put_pixel(px, py, color);
                                 }
@@ -37,7 +49,7 @@ pub fn draw_text(img: &mut RgbImage, x: u32, y: u32, text: &str, color: Rgb<u8>)
                 }
             }
         }
-        cx += 8 * TEXT_SCALE;
+        cx += 8 * scale;
     }
 }
 
@@ -70,7 +82,8 @@ pub fn grid(title: Option<&str>, rows: &[Vec<(String, RgbImage)>]) -> RgbImage {
         .unwrap_or(0);
     let cell_w = cell_w.max(label_w);
     let title_h = if title.is_some() { LABEL_HEIGHT } else { 0 };
-    let width = cols * (cell_w + PAD) + PAD;
+    let title_w = title.map_or(0, |t| text_width(t) + 2 * PAD);
+    let width = (cols * (cell_w + PAD) + PAD).max(title_w);
     let height = title_h + rows.len() as u32 * (cell_h + LABEL_HEIGHT) + PAD;
     let mut out = RgbImage::from_pixel(width, height, BACKGROUND);
     if let Some(t) = title {
@@ -101,12 +114,38 @@ pub fn error_map(width: u32, height: u32, values: &[f64], full_scale: f64) -> Rg
     })
 }
 
+/// Maps `t` in [-1, 1] to the diverging scale of signed error maps
+/// (d3's RdBu: negative red, zero white, positive blue).
+pub fn signed_error_color(t: f64) -> Rgb<u8> {
+    let c = colorous::RED_BLUE.eval_continuous(0.5 + 0.5 * t.clamp(-1.0, 1.0));
+    Rgb([c.r, c.g, c.b])
+}
+
+/// A signed error map: `values` (row-major) divided by `full_scale` and
+/// coloured by [`signed_error_color`]; values beyond +-1 saturate.
+pub fn signed_error_map(width: u32, height: u32, values: &[f64], full_scale: f64) -> RgbImage {
+    RgbImage::from_fn(width, height, |x, y| {
+        signed_error_color(values[(y * width + x) as usize] / full_scale)
+    })
+}
+
 /// A horizontal colour bar of `width` pixels with its end labels.
 pub fn color_bar(width: u32, low: &str, high: &str) -> RgbImage {
+    color_bar_with(width, low, high, error_color)
+}
+
+/// A colour bar of the signed scale, from -1 (left) to 1 (right).
+pub fn signed_color_bar(width: u32, low: &str, high: &str) -> RgbImage {
+    color_bar_with(width, low, high, |t| signed_error_color(2.0 * t - 1.0))
+}
+
+/// A horizontal bar of `color(t)`, `t` from 0 at the left to 1 at the
+/// right, with its end labels below.
+fn color_bar_with(width: u32, low: &str, high: &str, color: impl Fn(f64) -> Rgb<u8>) -> RgbImage {
     let bar_h = 14;
     let mut img = RgbImage::from_pixel(width, bar_h + LABEL_HEIGHT, BACKGROUND);
     for x in 0..width {
-        let c = error_color(f64::from(x) / f64::from(width.max(2) - 1));
+        let c = color(f64::from(x) / f64::from(width.max(2) - 1));
         for y in 0..bar_h {
             img.put_pixel(x, y, c);
         }
@@ -115,6 +154,17 @@ pub fn color_bar(width: u32, low: &str, high: &str) -> RgbImage {
     let hw = text_width(high);
     draw_text(&mut img, width.saturating_sub(hw), bar_h + PAD, high, INK);
     img
+}
+
+/// `img` enlarged `factor` times, each pixel a square block (no
+/// smoothing, so per-pixel noise stays visible as it is).
+pub fn enlarge(img: &RgbImage, factor: u32) -> RgbImage {
+    image::imageops::resize(
+        img,
+        img.width() * factor,
+        img.height() * factor,
+        image::imageops::FilterType::Nearest,
+    )
 }
 
 /// Stacks images vertically, left-aligned, on the background colour.

@@ -10,6 +10,7 @@ use image::RgbImage;
 use lueur::integrator::{Film, RenderSettings, Strategy};
 
 use crate::compose::{color_bar, error_map, grid, stack};
+use crate::pointset_figures::{ErrorSpectrumPlan, PointsPlan, pointsets_figure, zsobol_figure};
 use crate::reference::{flatten, reference};
 use crate::{docs_dir, load_scene, render_with_bar};
 
@@ -23,6 +24,11 @@ struct Plan {
     compare_size: u32,
     compare_spp: [u32; 2],
     reference_spp: u32,
+    /// Figure 8: points per set and seeds averaged in each spectrum.
+    points: PointsPlan,
+    /// Figure 10: spp of the two samplers' renders and seeds averaged.
+    error_spp: u32,
+    error_seeds: u64,
 }
 
 const FULL: Plan = Plan {
@@ -31,6 +37,9 @@ const FULL: Plan = Plan {
     compare_size: 128,
     compare_spp: [4, 128],
     reference_spp: 4096,
+    points: PointsPlan { n: 1024, seeds: 8 },
+    error_spp: 4,
+    error_seeds: 8,
 };
 
 const QUICK: Plan = Plan {
@@ -39,6 +48,9 @@ const QUICK: Plan = Plan {
     compare_size: 48,
     compare_spp: [4, 32],
     reference_spp: 256,
+    points: PointsPlan { n: 256, seeds: 2 },
+    error_spp: 4,
+    error_seeds: 4,
 };
 
 /// Relative error shown as the top of the colour scale of error maps.
@@ -197,6 +209,25 @@ pub fn run(quick: bool) -> Result<()> {
         )?;
     }
 
+    // Figure 8: the point sets of lueur-sampling and their spectra.
+    md.push_str(&pointsets_figure(&dir, &plan.points, flag)?);
+
+    // Figure 10: the zsobol sampler's error is blue noise on screen. The
+    // donut's reference above is reused (same scene and size).
+    md.push_str(&zsobol_figure(
+        &dir,
+        scene,
+        &file,
+        &reference.mean,
+        &ErrorSpectrumPlan {
+            size,
+            spp: plan.error_spp,
+            seeds: plan.error_seeds,
+            reference_spp: plan.reference_spp,
+        },
+        flag,
+    )?);
+
     let md_path = docs_dir(quick).join("FIGURES.md");
     std::fs::write(&md_path, md).with_context(|| format!("writing {}", md_path.display()))?;
     eprintln!(
@@ -232,7 +263,7 @@ fn to_rgb(film: &Film) -> RgbImage {
     RgbImage::from_raw(film.width(), film.height(), film.srgb8(0.0)).expect("film size matches")
 }
 
-fn save(img: &RgbImage, path: &Path) -> Result<()> {
+pub fn save(img: &RgbImage, path: &Path) -> Result<()> {
     img.save(path)
         .with_context(|| format!("writing {}", path.display()))
 }

@@ -3,7 +3,10 @@
 
 mod compose;
 mod figures;
+mod plot;
+mod pointset_figures;
 mod reference;
+mod spectrum;
 mod tradeoff;
 mod variance;
 
