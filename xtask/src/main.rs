@@ -6,6 +6,7 @@ mod figures;
 mod plot;
 mod pointset_figures;
 mod reference;
+mod samplers;
 mod spectrum;
 mod tradeoff;
 mod variance;
@@ -39,6 +40,19 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Measure each sampler's image error at 4 to 256 spp on two scenes, with
+    /// the convergence slope; checks the default sampler; writes
+    /// docs/SAMPLERS.md.
+    Samplers {
+        /// Smaller images and fewer samples, for CI.
+        #[arg(long)]
+        quick: bool,
+        /// Rewrite the report from the last measurement's CSV in
+        /// target/xtask/ without rendering (after a change of the default
+        /// sampler, say).
+        #[arg(long)]
+        report_only: bool,
+    },
     /// Measure error against time for each strategy and sampler, and what
     /// the marching knobs and max_depth cost and buy; writes docs/TRADEOFF.md.
     Tradeoff {
@@ -53,6 +67,7 @@ fn main() -> Result<()> {
         Command::Figures { quick } => figures::run(quick),
         Command::Variance { quick } => variance::run(quick),
         Command::Tradeoff { quick } => tradeoff::run(quick),
+        Command::Samplers { quick, report_only } => samplers::run(quick, report_only),
     }
 }
 
