@@ -8,6 +8,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use image::RgbImage;
 use lueur::integrator::{Film, RenderSettings, Strategy};
+use lueur::sampling::SamplerKind;
 
 use crate::compose::{color_bar, error_map, grid, stack};
 use crate::pointset_figures::{ErrorSpectrumPlan, PointsPlan, pointsets_figure, zsobol_figure};
@@ -91,7 +92,7 @@ pub fn run(quick: bool) -> Result<()> {
         save(&to_rgb(&film), &dir.join(format!("{name}.png")))?;
         writeln!(
             md,
-            "## {}\n\n![]({name}.png)\n\n`scenes/{name}.toml`, {}x{}, `mis`, {} spp.\n",
+            "## {}\n\n![]({name}.png)\n\n`scenes/{name}.toml`, {}x{}, `mis`, `{}`, {} spp.\n",
             match i {
                 0 => "Figure 1: the Death Star under a light at infinity",
                 1 => "Figure 2: the donut between two mirror spheres",
@@ -99,12 +100,14 @@ pub fn run(quick: bool) -> Result<()> {
             },
             plan.showcase_size,
             plan.showcase_size,
+            settings.sampler,
             plan.showcase_spp
         )?;
     }
 
     // Figures 3 to 7: each strategy at two sample counts on the donut, with
-    // error maps against a reference.
+    // error maps against a reference. Independent samples, as in the report:
+    // the differences are then the strategies' alone.
     let scene = "donut-mirrors";
     let file = load_scene(scene)?;
     let size = plan.compare_size;
@@ -123,6 +126,7 @@ pub fn run(quick: bool) -> Result<()> {
                 height: size,
                 spp,
                 strategy,
+                sampler: SamplerKind::Independent,
                 ..file.settings.clone()
             };
             let label = format!("donut {strategy} {spp} spp");
@@ -172,8 +176,8 @@ pub fn run(quick: bool) -> Result<()> {
         writeln!(
             md,
             "## Figure {number}: {what}\n\n![]({file_name})\n\n`scenes/{scene}.toml` at {size}x{size}, \
-             `--strategy {strategy}`, {low} and {high} spp; below each image its error map and mean \
-             relative error.\n"
+             `--strategy {strategy} --sampler independent`, {low} and {high} spp; below each image its \
+             error map and mean relative error.\n"
         )?;
     }
     for (number, spp) in [(6, high), (7, low)] {
@@ -203,7 +207,8 @@ pub fn run(quick: bool) -> Result<()> {
         writeln!(
             md,
             "## Figure {number}: uniform, mixture, light and mis at {spp} spp\n\n![]({file_name})\n\n\
-             The report's side-by-side comparison at equal samples, with `mis` added, and the error maps. \
+             The report's side-by-side comparison at equal samples (independent samples), with `mis` \
+             added, and the error maps. \
              `light` looks smoothest but is wrong where light arrives through the mirrors: its error \
              does not fall with more samples.\n"
         )?;
