@@ -16,6 +16,7 @@ use std::fmt::Write as _;
 use anyhow::{Context, Result, bail};
 use lueur::integrator::{RenderSettings, Strategy};
 use lueur::sampling::SamplerKind;
+use lueur::sampling::pointsets::least_squares_slope;
 
 use crate::reference::{cache_dir, flatten, reference, render_film};
 use crate::{docs_dir, load_scene};
@@ -270,18 +271,11 @@ fn report(plan: &Plan, quick: bool, table: &Table) -> Result<()> {
 /// Least-squares slope of log MSE against log spp (non-positive MSEs, noise
 /// below the reference's, are left out).
 fn slope(spps: &[u32], mses: &[f64]) -> f64 {
-    let points: Vec<(f64, f64)> = spps
+    let (xs, ys): (Vec<f64>, Vec<f64>) = spps
         .iter()
         .zip(mses)
         .filter(|(_, m)| **m > 0.0)
         .map(|(&s, &m)| (f64::from(s).ln(), m.ln()))
-        .collect();
-    let n = points.len() as f64;
-    let (mx, my) = points
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
-    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), (x, y)| {
-        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
-    });
-    sxy / sxx
+        .unzip();
+    least_squares_slope(&xs, &ys)
 }
