@@ -318,6 +318,30 @@ fn an_error_target_stops_the_render_when_reached() {
     assert!(err.contains("target error reached"), "{err}");
 }
 
+/// A render of the donut at `size` x `size` that would run for hours,
+/// writing `i.png` in `dir`, its stderr piped.
+#[cfg(unix)]
+fn spawn_long_render(dir: &Path, size: u32) -> std::process::Child {
+    let size = size.to_string();
+    Command::new(env!("CARGO_BIN_EXE_lueur"))
+        .args([
+            "render",
+            &scene("donut-mirrors"),
+            "--width",
+            &size,
+            "--height",
+            &size,
+            "--spp",
+            "1000000",
+            "--out",
+            "i.png",
+        ])
+        .current_dir(dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 /// A signal mid-render: the last complete pass is written, a whole number
 /// of spp, and the exit status says the render did not finish.
 #[cfg(unix)]
@@ -325,23 +349,7 @@ fn interrupt_with(signal: &str) {
     use std::time::{Duration, Instant};
 
     let dir = tempfile::tempdir().unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_lueur"))
-        .args([
-            "render",
-            &scene("donut-mirrors"),
-            "--width",
-            "32",
-            "--height",
-            "32",
-            "--spp",
-            "1000000",
-            "--out",
-            "i.png",
-        ])
-        .current_dir(dir.path())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = spawn_long_render(dir.path(), 32);
     // Long enough for the first passes to complete on a slow machine.
     std::thread::sleep(Duration::from_millis(1500));
     let status = Command::new("kill")
@@ -392,23 +400,7 @@ fn a_second_interrupt_exits_at_once_leaving_nothing() {
     use std::time::{Duration, Instant};
 
     let dir = tempfile::tempdir().unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_lueur"))
-        .args([
-            "render",
-            &scene("donut-mirrors"),
-            "--width",
-            "256",
-            "--height",
-            "256",
-            "--spp",
-            "1000000",
-            "--out",
-            "i.png",
-        ])
-        .current_dir(dir.path())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = spawn_long_render(dir.path(), 256);
     std::thread::sleep(Duration::from_millis(300));
     let kill = || {
         let status = Command::new("kill")

@@ -98,6 +98,18 @@ mod tests {
         }
     }
 
+    /// `p . gradient`: the same gradient everywhere.
+    struct Linear(Vec3);
+
+    impl DistanceField for Linear {
+        fn distance(&self, p: Vec3) -> f32 {
+            p.dot(self.0)
+        }
+        fn lipschitz(&self) -> f32 {
+            self.0.length()
+        }
+    }
+
     #[test]
     fn degenerate_fields_fall_back() {
         for f in [0.0, 1.0, f32::NAN, f32::INFINITY] {
@@ -111,15 +123,6 @@ mod tests {
 
     #[test]
     fn tiny_and_huge_gradients_normalise() {
-        struct Linear(Vec3);
-        impl DistanceField for Linear {
-            fn distance(&self, p: Vec3) -> f32 {
-                p.dot(self.0)
-            }
-            fn lipschitz(&self) -> f32 {
-                self.0.length()
-            }
-        }
         for scale in [1e-30, 1.0, 1e30] {
             let field = Linear(Vec3::new(3.0, 0.0, 4.0) * scale);
             let expected = Vec3::new(0.6, 0.0, 0.8);
@@ -133,15 +136,6 @@ mod tests {
         // A linear field has the same gradient everywhere: both difference
         // schemes must return it, not a multiple, near and far from the
         // origin (where h is raised to a few ulps of p).
-        struct Linear(Vec3);
-        impl DistanceField for Linear {
-            fn distance(&self, p: Vec3) -> f32 {
-                p.dot(self.0)
-            }
-            fn lipschitz(&self) -> f32 {
-                self.0.length()
-            }
-        }
         let g = Vec3::new(0.36, -0.48, 0.8);
         for p in [Vec3::ZERO, Vec3::ONE, Vec3::splat(1e3)] {
             for grad in [
