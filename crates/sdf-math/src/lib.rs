@@ -40,6 +40,7 @@
 #![deny(missing_docs)]
 
 mod blend;
+mod bound;
 mod field;
 mod normal;
 mod primitives;
@@ -50,6 +51,7 @@ mod trace;
 pub use glam::{Quat, Vec3};
 
 pub use crate::blend::{smooth_max, smooth_min};
+pub use crate::bound::{Aabb, HalfSpace};
 pub use crate::field::DistanceField;
 pub use crate::normal::{FALLBACK_NORMAL, gradient, gradient_central, normal, normal_central};
 pub use crate::ray::Ray;

@@ -4,6 +4,7 @@ use glam::{Quat, Vec3};
 
 use crate::DistanceField;
 use crate::blend::{smooth_max, smooth_min};
+use crate::bound::{Aabb, HalfSpace};
 use crate::primitives::{self, DeathStarKind};
 
 /// A signed distance function as a closed enum tree: evaluation is a `match`, never a
@@ -478,6 +479,167 @@ impl Sdf {
             }
         }
     }
+}
+
+impl Sdf {
+    /// A conservative axis-aligned bounding box, or `None` when the shape is unbounded.
+    ///
+    /// Contract, as for [`Sdf::bounding_sphere`] stronger than containment: for every `p`
+    /// outside the box, `distance(p) >=` the Euclidean distance from `p` to the box. So a
+    /// ray that stays farther from the box than the hit threshold can never hit the shape
+    /// ([`Aabb::hit_interval`]), and outside the box its distance is a safe step.
+    ///
+    /// Tighter than the sphere for flat and long shapes (a wall's sphere holds the whole
+    /// room; its box is the wall). Rotated children get the box around their rotated box,
+    /// which may be up to sqrt(3) times larger. Always finite, or `None`.
+    pub fn bounding_box(&self) -> Option<Aabb> {
+        self.bounding_box_unchecked().filter(Aabb::is_finite)
+    }
+
+    fn bounding_box_unchecked(&self) -> Option<Aabb> {
+        const NOTHING: Option<Aabb> = Some(Aabb {
+            min: Vec3::ZERO,
+            max: Vec3::ZERO,
+        });
+        let centered = |half: Vec3| Some(Aabb::from_center(Vec3::ZERO, half.max(Vec3::ZERO)));
+        match self {
+            Self::Sphere { radius } => centered(Vec3::splat(*radius)),
+            Self::Box { half_extents } | Self::RoundBox { half_extents, .. } => {
+                centered(*half_extents)
+            }
+            Self::Plane { .. } => None,
+            Self::Torus {
+                major_radius,
+                minor_radius,
+            } => {
+                let (big, small) = (major_radius.max(0.0), minor_radius.max(0.0));
+                centered(Vec3::new(big + small, small, big + small))
+            }
+            Self::CappedCylinder {
+                radius,
+                half_height,
+            } => centered(Vec3::new(*radius, *half_height, *radius)),
+            Self::Capsule { a, b, radius } => {
+                let r = Vec3::splat(radius.max(0.0));
+                Some(Aabb {
+                    min: a.min(*b) - r,
+                    max: a.max(*b) + r,
+                })
+            }
+            // The field is at least the distance to the kept sphere (the rim circle lies
+            // on it), so that sphere's box will do.
+            Self::DeathStar { ra, .. } => centered(Vec3::splat(*ra)),
+            Self::Union(children) => union_boxes(children),
+            Self::SmoothUnion { k, children } => {
+                let merged = union_boxes(children)?;
+                let blends = children.len().saturating_sub(1) as f32;
+                Some(merged.inflate(blends * k.max(0.0)))
+            }
+            // max(f0, ...) >= f_i for every i: any bounded child's box will do; the
+            // smallest by its diagonal.
+            Self::Intersection(children) | Self::SmoothIntersection { children, .. } => children
+                .iter()
+                .filter_map(Self::bounding_box)
+                .min_by(|x, y| {
+                    let size = |b: &Aabb| b.half_extents().length_squared();
+                    size(x).total_cmp(&size(y))
+                }),
+            Self::Difference(children) | Self::SmoothDifference { children, .. } => {
+                match children.first() {
+                    None => NOTHING,
+                    Some(first) => first.bounding_box(),
+                }
+            }
+            Self::Translate { offset, child } => {
+                let b = child.bounding_box()?;
+                Some(Aabb {
+                    min: b.min + *offset,
+                    max: b.max + *offset,
+                })
+            }
+            // The rotated box's own box: centre rotated, half extents through |R|.
+            Self::Rotate { rotation, child } => {
+                let b = child.bounding_box()?;
+                let h = b.half_extents();
+                let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|e| rotate(*rotation, e).abs());
+                let half = x * h.x + y * h.y + z * h.z;
+                Some(Aabb::from_center(rotate(*rotation, b.center()), half))
+            }
+            Self::Scale { factor, child } => {
+                if usable_factor(*factor) {
+                    let b = child.bounding_box()?;
+                    Some(Aabb::from_center(
+                        b.center() * *factor,
+                        b.half_extents() * factor.abs(),
+                    ))
+                } else {
+                    NOTHING
+                }
+            }
+        }
+    }
+
+    /// A half-space the field never undercuts, or `None`: for every `p`,
+    /// `distance(p) >= dot(p, normal) - height` (everywhere, inside too). Planes and what
+    /// is cut from them (intersections, differences) have one; a tracer clips rays
+    /// against it exactly ([`HalfSpace::hit_interval`]), which is what makes rays that
+    /// leave a floor, or stay above it, cost nothing for the floor.
+    pub fn bounding_half_space(&self) -> Option<HalfSpace> {
+        self.bounding_half_space_unchecked()
+            .filter(|h| h.normal.is_finite() && h.height.is_finite())
+    }
+
+    fn bounding_half_space_unchecked(&self) -> Option<HalfSpace> {
+        match self {
+            // Equality: the field is that linear function.
+            Self::Plane { normal, height } => Some(HalfSpace {
+                normal: *normal,
+                height: *height,
+            }),
+            Self::Intersection(children) | Self::SmoothIntersection { children, .. } => {
+                children.iter().find_map(Self::bounding_half_space)
+            }
+            Self::Difference(children) | Self::SmoothDifference { children, .. } => {
+                children.first()?.bounding_half_space()
+            }
+            Self::Translate { offset, child } => {
+                let h = child.bounding_half_space()?;
+                Some(HalfSpace {
+                    normal: h.normal,
+                    height: h.height + offset.dot(h.normal),
+                })
+            }
+            Self::Rotate { rotation, child } => {
+                let h = child.bounding_half_space()?;
+                Some(HalfSpace {
+                    normal: rotate(*rotation, h.normal),
+                    height: h.height,
+                })
+            }
+            // |c| f(p / c) >= |c| (dot(p / c, n) - h) = dot(p, sign(c) n) - |c| h.
+            Self::Scale { factor, child } if usable_factor(*factor) => {
+                let h = child.bounding_half_space()?;
+                Some(HalfSpace {
+                    normal: h.normal * factor.signum(),
+                    height: h.height * factor.abs(),
+                })
+            }
+            _ => None,
+        }
+    }
+}
+
+/// Union of the children's boxes: an empty box for no children (the empty shape), `None`
+/// if any child is unbounded.
+fn union_boxes(children: &[Sdf]) -> Option<Aabb> {
+    let mut boxes = children.iter().map(Sdf::bounding_box);
+    let Some(first) = boxes.next() else {
+        return Some(Aabb {
+            min: Vec3::ZERO,
+            max: Vec3::ZERO,
+        });
+    };
+    boxes.try_fold(first?, |acc, b| Some(acc.union(&b?)))
 }
 
 impl DistanceField for Sdf {

@@ -288,10 +288,67 @@ mod checks {
         );
         Ok(())
     }
+
+    pub fn bounding_box(sdf: &Sdf, p: Vec3) -> Result<(), TestCaseError> {
+        if let Some(b) = sdf.bounding_box() {
+            prop_assert!(b.is_finite() && b.min.cmple(b.max).all(), "{b:?}");
+            let f = sdf.distance(p);
+            let outside = b.distance_squared(p).sqrt();
+            let tol = slack(&[p.length(), b.min.length(), b.max.length(), f]);
+            // Inside the box the contract says nothing (the field may be negative there).
+            prop_assert!(
+                outside == 0.0 || f >= outside - tol,
+                "f = {f} < distance to the box {b:?} = {outside} at {p}"
+            );
+        }
+        if let Some(h) = sdf.bounding_half_space() {
+            let f = sdf.distance(p);
+            let below = h.value(p);
+            let tol = slack(&[p.length() * h.normal.length(), h.height, f]);
+            prop_assert!(
+                f >= below - tol,
+                "f = {f} < half-space {h:?} = {below} at {p}"
+            );
+        }
+        Ok(())
+    }
+    /// A ray that reaches `p` at `t = back`: if a tracer would call `p` a hit, the
+    /// bounds' hit intervals must hold `back`.
+    pub fn hit_interval(sdf: &Sdf, p: Vec3, dir: Vec3, back: f32) -> Result<(), TestCaseError> {
+        let params = TraceParams {
+            t_min: 0.0,
+            t_max: 1e5,
+            max_steps: 512,
+            eps_abs: 1e-4,
+            eps_rel: 1e-3,
+        };
+        let ray = Ray::new(p - dir * back, dir);
+        // The point the tracer would evaluate, with its rounding.
+        let at = ray.at(back);
+        let f = sdf.distance(at);
+        if !(f < params.eps_abs.max(params.eps_rel * back)) {
+            return Ok(());
+        }
+        if let Some(b) = sdf.bounding_box() {
+            let got = b.hit_interval(&ray, &params);
+            prop_assert!(
+                got.is_some_and(|(t0, t1)| t0 <= back && back <= t1),
+                "f({at}) = {f} at t = {back}, but the box {b:?} gives {got:?} for {ray:?}"
+            );
+        }
+        if let Some(h) = sdf.bounding_half_space() {
+            let got = h.hit_interval(&ray, &params);
+            prop_assert!(
+                got.is_some_and(|(t0, t1)| t0 <= back && back <= t1),
+                "f({at}) = {f} at t = {back}, but the half-space {h:?} gives {got:?} for {ray:?}"
+            );
+        }
+        Ok(())
+    }
 }
 
 /// Conformance: every shape is Lipschitz with its reported bound, has finite unit
-/// normals everywhere, and honours its bounding sphere (after fidget's `point_tests!`).
+/// normals everywhere, and honours its bounding sphere, box and half-space (after fidget's `point_tests!`).
 macro_rules! conformance {
     ($($name:ident => $strategy:expr;)*) => {$(
         mod $name {
@@ -326,6 +383,29 @@ macro_rules! conformance {
                         let (p, q) = points(&sdf, probe);
                         checks::bounding_sphere(&sdf, p)?;
                         checks::bounding_sphere(&sdf, q)?;
+                    }
+                }
+
+                #[test]
+                fn bounding_box_and_half_space_are_conservative(sdf in $strategy, probes in prop::collection::vec(probe(), 8)) {
+                    for probe in &probes {
+                        let (p, q) = points(&sdf, probe);
+                        checks::bounding_box(&sdf, p)?;
+                        checks::bounding_box(&sdf, q)?;
+                    }
+                }
+
+                #[test]
+                fn hit_intervals_hold_every_point_below_the_threshold(
+                    sdf in $strategy,
+                    probes in prop::collection::vec(probe(), 8),
+                    dirs in prop::collection::vec(unit(), 8),
+                    back in prop::collection::vec(log_uniform(-3.0, 3.0), 8),
+                ) {
+                    for ((probe, dir), back) in probes.iter().zip(&dirs).zip(&back) {
+                        let (p, q) = points(&sdf, probe);
+                        checks::hit_interval(&sdf, p, *dir, *back)?;
+                        checks::hit_interval(&sdf, q, -*dir, *back)?;
                     }
                 }
             }
