@@ -8,10 +8,13 @@ use lueur_sampling::{
     quad_solid_angle_pdf, sample_cosine_hemisphere, sample_quad_area, sample_quad_solid_angle,
     sample_sphere_light, sphere_light_pdf,
 };
+use std::cell::Cell;
+
 use lueur_sdf_math::{
-    DistanceField, OVER_RELAXATION, Ray, Sdf, TraceOutcome, TraceParams, sphere_trace,
-    sphere_trace_relaxed,
+    Aabb, DistanceField, HalfSpace, OVER_RELAXATION, Ray, RayClip, Sdf, TraceOutcome, TraceParams,
+    sphere_trace, sphere_trace_relaxed,
 };
+use smallvec::SmallVec;
 
 use crate::{Camera, SceneError};
 
@@ -88,9 +91,13 @@ pub enum Marching {
     /// Plain Hart sphere tracing on the plain union of the objects: every step evaluates
     /// every object; normals by central differences.
     Naive,
-    /// Over-relaxed sphere tracing (Keinert et al. 2014) on the union with bounding-sphere
-    /// culling: an object whose bounding sphere is farther than the nearest object found so
-    /// far costs one distance to a sphere, not its own evaluation; normals by the
+    /// Each ray first clipped against every object's bound (a box, or a half-space for
+    /// planes): objects whose bound the ray never comes within the hit threshold of are left
+    /// out of its march altogether, and the march runs only over the part of the ray some
+    /// bound covers. Then over-relaxed sphere tracing (Keinert et al. 2014) on the union of
+    /// what is left, where an object whose box is farther than the nearest object found so
+    /// far costs one distance to a box, not its own evaluation. The object hit is the one
+    /// the last step found nearest (no second pass over the scene); normals by the
     /// tetrahedron (4 evaluations, not 6).
     #[default]
     Fast,
@@ -134,12 +141,128 @@ pub(crate) enum Emitter {
 pub(crate) struct Geometry {
     sdfs: Vec<Sdf>,
     lipschitz: f32,
+    /// Per object: what a ray is clipped against before it is marched.
+    bounds: Vec<ObjectBound>,
     /// Objects evaluated at every point: those without a bounding sphere (planes) and
     /// those no dearer than their bound (spheres), first, so that the running minimum is
     /// small before the culled objects are reached.
     always: Vec<usize>,
     /// The other objects with their bounding spheres, in scene order.
     culled: Vec<Bounded>,
+}
+
+/// What a ray is clipped against for one object (see [`Marching::Fast`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum ObjectBound {
+    /// The object's bounding box; `cull` when checking the box is cheaper than evaluating
+    /// the object (not for boxes and spheres, whose box check costs as much as they do).
+    Box { aabb: Aabb, cull: bool },
+    /// Planes and what is cut from them.
+    HalfSpace(HalfSpace),
+    /// Nothing known: the object takes part in every march.
+    Everywhere,
+}
+
+impl ObjectBound {
+    fn of(sdf: &Sdf) -> ObjectBound {
+        if let Some(aabb) = sdf.bounding_box() {
+            let cull = !is_sphere(sdf) && !is_box(sdf);
+            ObjectBound::Box { aabb, cull }
+        } else if let Some(h) = sdf.bounding_half_space() {
+            ObjectBound::HalfSpace(h)
+        } else {
+            ObjectBound::Everywhere
+        }
+    }
+}
+
+/// One object a ray may hit, and from where along it. Small, so that a ray's list is
+/// cheap to build, sort and move.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    object: u32,
+    t0: f32,
+}
+
+/// The union of the objects one ray can hit ([`Marching::Fast`]), nearest entry first, and
+/// which of them the last evaluation found nearest.
+///
+/// Sphere tracing this field finds the same surface as tracing the whole union: an object
+/// left out has no point within the hit threshold on the marched range (its bound's
+/// contract, [`Aabb::hit_interval`]), so the whole union's march could not stop on it
+/// either, and the objects kept are evaluated exactly. Steps are longer, since the objects
+/// left out no longer shorten them: that is the point.
+struct RayField<'a> {
+    geometry: &'a Geometry,
+    candidates: SmallVec<[Candidate; 16]>,
+    nearest: Cell<u32>,
+}
+
+impl<'a> RayField<'a> {
+    /// The candidates of `ray` and the range of `t` to march, `None` when no object can be
+    /// hit.
+    fn new(geometry: &'a Geometry, ray: &Ray, params: &TraceParams) -> (Self, Option<(f32, f32)>) {
+        let mut candidates = SmallVec::new();
+        let mut range: Option<(f32, f32)> = None;
+        let clip = RayClip::new(ray, params);
+        for (object, bound) in geometry.bounds.iter().enumerate() {
+            let interval = match bound {
+                ObjectBound::Box { aabb, .. } => clip.clip_box(aabb),
+                ObjectBound::HalfSpace(h) => clip.clip_half_space(h),
+                ObjectBound::Everywhere => Some((params.t_min, params.t_max)),
+            };
+            let Some((t0, t1)) = interval else {
+                continue;
+            };
+            range = Some(range.map_or((t0, t1), |(a, b)| (a.min(t0), b.max(t1))));
+            candidates.push(Candidate {
+                object: object as u32,
+                t0,
+            });
+        }
+        // Nearest first: the running minimum is small early, so later boxes cull.
+        candidates.sort_unstable_by(|a: &Candidate, b: &Candidate| a.t0.total_cmp(&b.t0));
+        let field = RayField {
+            geometry,
+            candidates,
+            nearest: Cell::new(0),
+        };
+        (field, range)
+    }
+
+    /// The object the last evaluation found nearest: after a hit, the one that was hit.
+    fn nearest(&self) -> usize {
+        self.nearest.get() as usize
+    }
+}
+
+impl DistanceField for RayField<'_> {
+    #[inline]
+    fn distance(&self, p: Vec3) -> f32 {
+        let mut d = f32::INFINITY;
+        let mut nearest = self.candidates.first().map_or(0, |c| c.object);
+        for c in &self.candidates {
+            // The box is at most as far as the object (its contract): when it is already
+            // farther than the running minimum, the object cannot lower it.
+            if let ObjectBound::Box { aabb, cull: true } = &self.geometry.bounds[c.object as usize]
+                && d > 0.0
+                && aabb.distance_squared(p) >= d * d
+            {
+                continue;
+            }
+            let f = self.geometry.sdfs[c.object as usize].distance(p);
+            if f < d {
+                d = f;
+                nearest = c.object;
+            }
+        }
+        self.nearest.set(nearest);
+        d
+    }
+
+    fn lipschitz(&self) -> f32 {
+        self.geometry.lipschitz
+    }
 }
 
 /// An object with its bounding sphere.
@@ -171,6 +294,7 @@ impl Geometry {
         Geometry {
             sdfs: objects.iter().map(|o| o.sdf.clone()).collect(),
             lipschitz,
+            bounds: objects.iter().map(|o| ObjectBound::of(&o.sdf)).collect(),
             always,
             culled,
         }
@@ -219,6 +343,15 @@ fn is_sphere(sdf: &Sdf) -> bool {
     }
 }
 
+/// Whether the shape is a box, possibly moved: its bounding box is the shape itself.
+fn is_box(sdf: &Sdf) -> bool {
+    match sdf {
+        Sdf::Box { .. } => true,
+        Sdf::Translate { child, .. } => is_box(child),
+        _ => false,
+    }
+}
+
 /// [`Geometry`] as the plain union, for naive marching.
 struct Naive<'a>(&'a Geometry);
 
@@ -242,20 +375,6 @@ impl DistanceField for Inside<'_> {
     #[inline]
     fn distance(&self, p: Vec3) -> f32 {
         -self.0.distance_naive(p)
-    }
-
-    fn lipschitz(&self) -> f32 {
-        self.0.lipschitz
-    }
-}
-
-/// [`Geometry`] with bounding-sphere culling, for fast marching.
-struct Culled<'a>(&'a Geometry);
-
-impl DistanceField for Culled<'_> {
-    #[inline]
-    fn distance(&self, p: Vec3) -> f32 {
-        self.0.distance_culled(p)
     }
 
     fn lipschitz(&self) -> f32 {
@@ -487,12 +606,28 @@ impl Scene {
         }
     }
 
-    /// Marches `ray` through the objects as [`Scene::marching`] says.
-    fn trace(&self, ray: &Ray, params: &TraceParams) -> TraceOutcome {
+    /// Marches `ray` through the objects as [`Scene::marching`] says; with a hit, the
+    /// object hit.
+    fn trace(&self, ray: &Ray, params: &TraceParams) -> (TraceOutcome, Option<usize>) {
         match self.marching {
-            Marching::Naive => sphere_trace(&Naive(&self.geometry), ray, params),
+            Marching::Naive => {
+                let outcome = sphere_trace(&Naive(&self.geometry), ray, params);
+                let object = outcome.hit_t().map(|t| self.closest_object(ray.at(t)));
+                (outcome, object)
+            }
             Marching::Fast => {
-                sphere_trace_relaxed(&Culled(&self.geometry), ray, params, OVER_RELAXATION)
+                let (field, range) = RayField::new(&self.geometry, ray, params);
+                let Some((t_min, t_max)) = range else {
+                    return (TraceOutcome::Miss { steps: 0 }, None);
+                };
+                let clipped = TraceParams {
+                    t_min,
+                    t_max,
+                    ..*params
+                };
+                let outcome = sphere_trace_relaxed(&field, ray, &clipped, OVER_RELAXATION);
+                let object = outcome.hit_t().map(|_| field.nearest());
+                (outcome, object)
             }
         }
     }
@@ -551,8 +686,8 @@ impl Scene {
             let p = TraceParams { t_max, ..*params };
             let start = ray.at(p.t_min);
             let inside = maybe_inside && self.distance(start) < -p.eps_abs.max(p.eps_rel * p.t_min);
-            let outcome = if inside {
-                sphere_trace(&Inside(&self.geometry), ray, &p)
+            let (outcome, object) = if inside {
+                (sphere_trace(&Inside(&self.geometry), ray, &p), None)
             } else {
                 self.trace(ray, &p)
             };
@@ -565,7 +700,7 @@ impl Scene {
                 _ => outcome.hit_t(),
             };
             if let Some(t) = t_hit {
-                let object = self.closest_object(ray.at(t));
+                let object = object.unwrap_or_else(|| self.closest_object(ray.at(t)));
                 let epsilon = params.eps_abs.max(params.eps_rel * t);
                 surface = Some(Hit::Surface { t, object, epsilon });
             }
@@ -596,7 +731,7 @@ impl Scene {
         if self.objects.is_empty() || t_max <= params.t_min {
             return true;
         }
-        let outcome = self.trace(ray, &TraceParams { t_max, ..*params });
+        let (outcome, _) = self.trace(ray, &TraceParams { t_max, ..*params });
         counters.record(&outcome);
         outcome.hit_t().is_none()
     }

@@ -83,53 +83,153 @@ impl Aabb {
 
     /// The part of `[params.t_min, params.t_max]` where a field honouring this box (at
     /// least the distance to the box, outside it) can fall below the tracer's hit
-    /// threshold `max(eps_abs, eps_rel t)`; `None` where there is no such part.
-    ///
-    /// The box is grown by the largest threshold a point near it can have (a point within
-    /// `m` of the box is at most `|o - c| + |h| + sqrt(3) m` from the origin, so
-    /// `m = eps_rel (|o - c| + |h|) / (|d| - sqrt(3) eps_rel)` covers it) plus the `f32`
-    /// rounding of positions that far from the world origin, then clipped by the slab
-    /// method (Kay and Kajiya 1986; pbrt-v4 section 6.1.2), whose ends are widened by a
-    /// relative `1e-5`. Conservative: a wider interval only costs steps.
+    /// threshold `max(eps_abs, eps_rel t)`; `None` where there is no such part. See
+    /// [`RayClip::clip_box`]; when clipping one ray against many boxes, make the
+    /// [`RayClip`] once.
     pub fn hit_interval(&self, ray: &Ray, params: &TraceParams) -> Option<(f32, f32)> {
-        let whole = Some((params.t_min, params.t_max));
-        let speed = ray.dir.length();
-        let (eps_abs, eps_rel) = (params.eps_abs.max(0.0), params.eps_rel.max(0.0));
-        let (center, half) = (self.center(), self.half_extents());
-        let reach = (ray.origin - center).length() + half.length();
-        let room = speed - 3f32.sqrt() * eps_rel;
-        if !(room > 0.5 * speed && reach.is_finite()) {
-            // A threshold that grows as fast as the ray moves: no useful bound.
-            return whole;
-        }
-        let relative = (eps_rel * reach / room).min(eps_rel * params.t_max.max(0.0));
-        let rounding = 16.0 * f32::EPSILON * (ray.origin.length() + center.length() + reach);
-        let grown = self.inflate(eps_abs.max(relative) + rounding);
+        RayClip::new(ray, params).clip_box(self)
+    }
+}
 
-        let (mut t0, mut t1) = (params.t_min, params.t_max);
-        for axis in 0..3 {
-            let (o, d) = (ray.origin[axis], ray.dir[axis]);
-            let (lo, hi) = (grown.min[axis], grown.max[axis]);
-            if d == 0.0 {
-                if o < lo || o > hi {
-                    return None;
-                }
-                continue;
-            }
-            let inv = 1.0 / d;
-            let (mut near, mut far) = ((lo - o) * inv, (hi - o) * inv);
-            if near > far {
-                std::mem::swap(&mut near, &mut far);
-            }
-            // NaN-proof: a NaN end leaves the running interval as it was.
-            if near > t0 {
-                t0 = near;
-            }
-            if far < t1 {
-                t1 = far;
+/// One ray prepared for clipping against many bounds: what every clip shares (the
+/// reciprocals of the slopes, the thresholds) computed once.
+///
+/// Every bound is treated as an intersection of half-spaces (a box is six), and the field
+/// is at least the distance to the bound, so at least the signed distance to each of its
+/// planes (`dot(p, n) - h`, with unit `n` for a box). Along the ray each of those is
+/// linear in `t`, `a + b t`, and it can be below the hit threshold `max(eps_abs,
+/// eps_rel t)` only on `{a - eps_abs + b t < 0} ∪ {a + (b - eps_rel) t < 0}`: two
+/// half-lines, solved exactly. A hit is possible only where every plane allows it, so the
+/// interval is the intersection over the planes of each one's hull. No square root, no
+/// margin guessed from the ray's length: a ray leaving a wall is never a candidate for
+/// that wall (the plane it leaves grows faster than `eps_rel t`), however close it
+/// starts.
+#[derive(Clone, Copy, Debug)]
+pub struct RayClip {
+    origin: Vec3,
+    dir: Vec3,
+    /// `1 / d` and `1 / (d - eps_rel)` for the faces facing +x, +y, +z (whose plane values
+    /// change by `d` per unit `t`), and `1 / (-d - eps_rel)` for the faces facing -x, -y,
+    /// -z (the `1 / -d` of those is `-inv_dir`).
+    inv_dir: Vec3,
+    inv_rel_up: Vec3,
+    inv_rel_down: Vec3,
+    /// The largest coordinate of the origin: the rounding of positions near it.
+    origin_size: f32,
+    eps_abs: f32,
+    eps_rel: f32,
+    t_min: f32,
+    t_max: f32,
+}
+
+/// Every `t`.
+const ALL: (f32, f32) = (f32::NEG_INFINITY, f32::INFINITY);
+/// No `t` (neutral for a hull).
+const NONE: (f32, f32) = (f32::INFINITY, f32::NEG_INFINITY);
+
+/// `{t : alpha + beta t < 0}`, given `inv = 1 / beta`, as an interval (possibly infinite,
+/// possibly empty as [`NONE`]). A NaN anywhere gives [`ALL`]: keep what is not understood.
+#[inline]
+fn half_line(alpha: f32, beta: f32, inv: f32) -> (f32, f32) {
+    let root = -alpha * inv;
+    if root.is_nan() || beta.is_nan() {
+        ALL
+    } else if beta > 0.0 {
+        (f32::NEG_INFINITY, root)
+    } else if beta < 0.0 {
+        (root, f32::INFINITY)
+    } else if alpha < 0.0 {
+        ALL
+    } else {
+        NONE
+    }
+}
+
+/// The hull of the `t` where a plane value `a + b t` is below `max(eps_abs, eps_rel t)`.
+#[inline]
+fn below_threshold(a: f32, eps_abs: f32, b: f32, inv: f32, b_rel: f32, inv_rel: f32) -> (f32, f32) {
+    let (lo_abs, hi_abs) = half_line(a - eps_abs, b, inv);
+    let (lo_rel, hi_rel) = half_line(a, b_rel, inv_rel);
+    (lo_abs.min(lo_rel), hi_abs.max(hi_rel))
+}
+
+impl RayClip {
+    /// Prepares `ray` for clipping with the hit thresholds and range of `params`.
+    #[inline]
+    pub fn new(ray: &Ray, params: &TraceParams) -> RayClip {
+        let eps_rel = params.eps_rel.max(0.0);
+        let d = ray.dir;
+        RayClip {
+            origin: ray.origin,
+            dir: d,
+            inv_dir: d.recip(),
+            inv_rel_up: (d - Vec3::splat(eps_rel)).recip(),
+            inv_rel_down: (-d - Vec3::splat(eps_rel)).recip(),
+            origin_size: ray.origin.abs().max_element(),
+            eps_abs: params.eps_abs.max(0.0),
+            eps_rel,
+            t_min: params.t_min,
+            t_max: params.t_max,
+        }
+    }
+
+    /// [`Aabb::hit_interval`] for this ray: the six faces' intervals intersected (see the
+    /// type), clipped to the trace's range, its ends widened by a relative `1e-5`.
+    #[inline]
+    pub fn clip_box(&self, aabb: &Aabb) -> Option<(f32, f32)> {
+        // Taken off every plane value: the f32 rounding of positions this far out.
+        let rounding = 16.0
+            * f32::EPSILON
+            * (self.origin_size + aabb.min.abs().max(aabb.max.abs()).max_element());
+        // Plane values at the origin, minus the rounding: o - max for the faces facing +,
+        // min - o for those facing -.
+        let up = self.origin - aabb.max - Vec3::splat(rounding);
+        let down = aabb.min - self.origin - Vec3::splat(rounding);
+        let (mut t0, mut t1) = (self.t_min, self.t_max);
+        for k in 0..3 {
+            let d = self.dir[k];
+            for (lo, hi) in [
+                below_threshold(
+                    up[k],
+                    self.eps_abs,
+                    d,
+                    self.inv_dir[k],
+                    d - self.eps_rel,
+                    self.inv_rel_up[k],
+                ),
+                below_threshold(
+                    down[k],
+                    self.eps_abs,
+                    -d,
+                    -self.inv_dir[k],
+                    -d - self.eps_rel,
+                    self.inv_rel_down[k],
+                ),
+            ] {
+                t0 = t0.max(lo);
+                t1 = t1.min(hi);
             }
         }
-        widen(t0, t1, params)
+        widen(t0, t1, self.t_min, self.t_max)
+    }
+
+    /// [`HalfSpace::hit_interval`] for this ray: one plane, whose normal need not be unit
+    /// (the field is at least the plane's value, whatever its scale).
+    #[inline]
+    pub fn clip_half_space(&self, h: &HalfSpace) -> Option<(f32, f32)> {
+        let rounding = 16.0
+            * f32::EPSILON
+            * (self.origin_size * h.normal.abs().element_sum() + h.height.abs());
+        let a = h.value(self.origin) - rounding;
+        let b = self.dir.dot(h.normal);
+        let b_rel = b - self.eps_rel;
+        let (t0, t1) = below_threshold(a, self.eps_abs, b, b.recip(), b_rel, b_rel.recip());
+        widen(
+            t0.max(self.t_min),
+            t1.min(self.t_max),
+            self.t_min,
+            self.t_max,
+        )
     }
 }
 
@@ -157,45 +257,18 @@ impl HalfSpace {
     /// A ray parallel to a plane does reach it: `eps_rel t` grows until it exceeds the
     /// ray's height, as it does for a tracer marching that ray.
     pub fn hit_interval(&self, ray: &Ray, params: &TraceParams) -> Option<(f32, f32)> {
-        let (eps_abs, eps_rel) = (params.eps_abs.max(0.0), params.eps_rel.max(0.0));
-        let rounding =
-            16.0 * f32::EPSILON * (ray.origin.length() * self.normal.length() + self.height.abs());
-        let a = self.value(ray.origin) - rounding;
-        let b = ray.dir.dot(self.normal);
-        let below_abs = half_line(a - eps_abs, b);
-        let below_rel = half_line(a, b - eps_rel);
-        let (t0, t1) = match (below_abs, below_rel) {
-            (None, None) => return None,
-            (Some(x), None) | (None, Some(x)) => x,
-            (Some(x), Some(y)) => (x.0.min(y.0), x.1.max(y.1)),
-        };
-        widen(t0.max(params.t_min), t1.min(params.t_max), params)
+        RayClip::new(ray, params).clip_half_space(self)
     }
 }
 
-/// `{t : alpha + beta t < 0}` as an interval with infinite ends, or `None`.
-fn half_line(alpha: f32, beta: f32) -> Option<(f32, f32)> {
-    if beta > 0.0 {
-        Some((f32::NEG_INFINITY, -alpha / beta))
-    } else if beta < 0.0 {
-        Some((-alpha / beta, f32::INFINITY))
-    } else if alpha < 0.0 {
-        Some((f32::NEG_INFINITY, f32::INFINITY))
-    } else if alpha.is_nan() || beta.is_nan() {
-        // Unknown: keep everything rather than guess.
-        Some((f32::NEG_INFINITY, f32::INFINITY))
-    } else {
-        None
-    }
-}
-
-/// Widens `[t0, t1]` by a relative [`WIDEN`] and clips it to the trace's range.
-fn widen(t0: f32, t1: f32, params: &TraceParams) -> Option<(f32, f32)> {
+/// Widens `[t0, t1]` by a relative [`WIDEN`] and clips it to `[t_min, t_max]`.
+#[inline]
+fn widen(t0: f32, t1: f32, t_min: f32, t_max: f32) -> Option<(f32, f32)> {
     if t0.is_nan() || t1.is_nan() {
-        return Some((params.t_min, params.t_max));
+        return Some((t_min, t_max));
     }
-    let t0 = (t0 - WIDEN * t0.abs()).max(params.t_min);
-    let t1 = (t1 + WIDEN * t1.abs()).min(params.t_max);
+    let t0 = (t0 - WIDEN * t0.abs()).max(t_min);
+    let t1 = (t1 + WIDEN * t1.abs()).min(t_max);
     (t0 <= t1).then_some((t0, t1))
 }
 
@@ -238,6 +311,28 @@ mod tests {
         // From inside, the interval starts at t_min.
         let inside = Ray::new(Vec3::ZERO, Vec3::X);
         assert_eq!(b.hit_interval(&inside, &params()).unwrap().0, 0.0);
+    }
+
+    #[test]
+    fn a_ray_leaving_a_wall_is_not_a_candidate_for_it() {
+        // The floor slab y in [-0.1, 0]; rays start 1e-3 above it (ten hit thresholds).
+        let floor = Aabb {
+            min: Vec3::new(-1.0, -0.1, -1.0),
+            max: Vec3::new(1.0, 0.0, 1.0),
+        };
+        let p = params();
+        for dir in [
+            Vec3::Y,
+            Vec3::new(1.0, 0.1, 0.0),
+            Vec3::new(0.3, 0.01, -0.2),
+        ] {
+            let ray = Ray::new(Vec3::new(0.2, 1e-3, 0.3), dir);
+            assert_eq!(floor.hit_interval(&ray, &p), None, "{dir}");
+        }
+        // Nearly parallel (slope below eps_rel = 1e-3): the threshold catches up at
+        // t = 1e-3 / (1e-3 - 1e-4) ~ 1.1, still over the floor, so it is kept.
+        let creeping = Ray::new(Vec3::new(-0.9, 1e-3, 0.3), Vec3::new(1.0, 1e-4, 0.0));
+        assert!(floor.hit_interval(&creeping, &p).is_some());
     }
 
     #[test]
@@ -289,9 +384,11 @@ mod tests {
             height: 0.0,
         };
         assert!(h.hit_interval(&nan, &p).is_some());
-        // A threshold growing faster than the ray: the whole range.
+        // A threshold growing faster than the ray: at t = 50 the box is ~69 away and the
+        // threshold is 100, so that point must be kept.
         let wild = TraceParams { eps_rel: 2.0, ..p };
         let far = Ray::new(Vec3::new(0.0, 50.0, 0.0), Vec3::X);
-        assert_eq!(b.hit_interval(&far, &wild), Some((p.t_min, p.t_max)));
+        let (t0, t1) = b.hit_interval(&far, &wild).unwrap();
+        assert!(t0 <= 50.0 && 50.0 <= t1, "{t0} {t1}");
     }
 }

@@ -51,7 +51,7 @@ mod trace;
 pub use glam::{Quat, Vec3};
 
 pub use crate::blend::{smooth_max, smooth_min};
-pub use crate::bound::{Aabb, HalfSpace};
+pub use crate::bound::{Aabb, HalfSpace, RayClip};
 pub use crate::field::DistanceField;
 pub use crate::normal::{FALLBACK_NORMAL, gradient, gradient_central, normal, normal_central};
 pub use crate::ray::Ray;

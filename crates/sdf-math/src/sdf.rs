@@ -557,13 +557,28 @@ impl Sdf {
                     max: b.max + *offset,
                 })
             }
-            // The rotated box's own box: centre rotated, half extents through |R|.
+            // The rotated box's own box (centre rotated, half extents through |R|), or the
+            // box around the child's bounding sphere, which rotation does not grow (a
+            // sphere's field is at least the distance to that ball, so to its box):
+            // whichever is smaller.
             Self::Rotate { rotation, child } => {
                 let b = child.bounding_box()?;
                 let h = b.half_extents();
                 let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|e| rotate(*rotation, e).abs());
                 let half = x * h.x + y * h.y + z * h.z;
-                Some(Aabb::from_center(rotate(*rotation, b.center()), half))
+                let turned = Aabb::from_center(rotate(*rotation, b.center()), half);
+                let volume = |b: &Aabb| b.half_extents().element_product();
+                match child.bounding_sphere() {
+                    Some((c, r)) => {
+                        let ball = Aabb::from_center(rotate(*rotation, c), Vec3::splat(r));
+                        Some(if volume(&ball) < volume(&turned) {
+                            ball
+                        } else {
+                            turned
+                        })
+                    }
+                    None => Some(turned),
+                }
             }
             Self::Scale { factor, child } => {
                 if usable_factor(*factor) {
