@@ -12,7 +12,7 @@
 //! [`Sdf::bounding_box`]: crate::Sdf::bounding_box
 //! [`Sdf::bounding_half_space`]: crate::Sdf::bounding_half_space
 
-use glam::Vec3;
+use glam::{BVec3A, Vec3, Vec3A};
 
 use crate::{Ray, TraceParams};
 
@@ -106,20 +106,59 @@ impl Aabb {
 /// starts.
 #[derive(Clone, Copy, Debug)]
 pub struct RayClip {
-    origin: Vec3,
+    origin: Vec3A,
     dir: Vec3,
-    /// `1 / d` and `1 / (d - eps_rel)` for the faces facing +x, +y, +z (whose plane values
-    /// change by `d` per unit `t`), and `1 / (-d - eps_rel)` for the faces facing -x, -y,
-    /// -z (the `1 / -d` of those is `-inv_dir`).
-    inv_dir: Vec3,
-    inv_rel_up: Vec3,
-    inv_rel_down: Vec3,
+    /// The four families of box planes, per axis: faces facing + (value `o - max`, slope
+    /// `d`) and facing - (value `min - o`, slope `-d`), each against the absolute and the
+    /// relative threshold (slope less `eps_rel`). Slopes are per ray, so their reciprocals
+    /// and signs are too.
+    families: [Slope; 4],
+    /// A non-finite origin or direction: every clip keeps the whole range.
+    degenerate: bool,
     /// The largest coordinate of the origin: the rounding of positions near it.
     origin_size: f32,
     eps_abs: f32,
     eps_rel: f32,
     t_min: f32,
     t_max: f32,
+}
+
+/// The slope of one family of planes along the ray, per axis.
+#[derive(Clone, Copy, Debug)]
+struct Slope {
+    /// `1 / slope`, with a zero slope replaced by a tiny positive one, so that
+    /// `a + 0 t < 0` comes out as "every t" for negative `a` and "none" for positive `a`
+    /// with no special case.
+    inv: Vec3A,
+    /// Where the slope is positive: the set is `t < root`; elsewhere `t > root`.
+    rising: BVec3A,
+}
+
+impl Slope {
+    #[inline]
+    fn new(slope: Vec3A) -> Slope {
+        let slope = Vec3A::select(slope.cmpeq(Vec3A::ZERO), Vec3A::splat(1e-30), slope);
+        Slope {
+            inv: slope.recip(),
+            rising: slope.cmpgt(Vec3A::ZERO),
+        }
+    }
+
+    /// Per axis, the interval `{t : alpha + slope t < 0}` within `[t_min, t_max]`, an
+    /// empty one as `(inf, -inf)` so that it drops out of a hull (the hull of a half-line
+    /// at negative `t` and one at positive `t` is everything, clipped first it is the
+    /// second).
+    #[inline]
+    fn below(&self, alpha: Vec3A, t_min: Vec3A, t_max: Vec3A) -> (Vec3A, Vec3A) {
+        let root = -alpha * self.inv;
+        let lo = Vec3A::select(self.rising, t_min, root.max(t_min));
+        let hi = Vec3A::select(self.rising, root.min(t_max), t_max);
+        let empty = lo.cmpgt(hi);
+        (
+            Vec3A::select(empty, Vec3A::INFINITY, lo),
+            Vec3A::select(empty, Vec3A::NEG_INFINITY, hi),
+        )
+    }
 }
 
 /// Every `t`.
@@ -145,11 +184,24 @@ fn half_line(alpha: f32, beta: f32, inv: f32) -> (f32, f32) {
     }
 }
 
-/// The hull of the `t` where a plane value `a + b t` is below `max(eps_abs, eps_rel t)`.
+/// The hull, within `range`, of the `t` where a plane value `a + b t` is below
+/// `max(eps_abs, eps_rel t)`; [`NONE`] if there are none. Each set is clipped to the range
+/// before the hull is taken, so that a half-line at negative `t` does not drag it to
+/// everything.
 #[inline]
-fn below_threshold(a: f32, eps_abs: f32, b: f32, inv: f32, b_rel: f32, inv_rel: f32) -> (f32, f32) {
-    let (lo_abs, hi_abs) = half_line(a - eps_abs, b, inv);
-    let (lo_rel, hi_rel) = half_line(a, b_rel, inv_rel);
+fn below_threshold(
+    a: f32,
+    eps_abs: f32,
+    (b, inv): (f32, f32),
+    (b_rel, inv_rel): (f32, f32),
+    (t_min, t_max): (f32, f32),
+) -> (f32, f32) {
+    let clip = |(lo, hi): (f32, f32)| {
+        let (lo, hi) = (lo.max(t_min), hi.min(t_max));
+        if lo <= hi { (lo, hi) } else { NONE }
+    };
+    let (lo_abs, hi_abs) = clip(half_line(a - eps_abs, b, inv));
+    let (lo_rel, hi_rel) = clip(half_line(a, b_rel, inv_rel));
     (lo_abs.min(lo_rel), hi_abs.max(hi_rel))
 }
 
@@ -158,13 +210,18 @@ impl RayClip {
     #[inline]
     pub fn new(ray: &Ray, params: &TraceParams) -> RayClip {
         let eps_rel = params.eps_rel.max(0.0);
-        let d = ray.dir;
+        let d = Vec3A::from(ray.dir);
+        let rel = Vec3A::splat(eps_rel);
         RayClip {
-            origin: ray.origin,
-            dir: d,
-            inv_dir: d.recip(),
-            inv_rel_up: (d - Vec3::splat(eps_rel)).recip(),
-            inv_rel_down: (-d - Vec3::splat(eps_rel)).recip(),
+            origin: ray.origin.into(),
+            dir: ray.dir,
+            families: [
+                Slope::new(d),
+                Slope::new(d - rel),
+                Slope::new(-d),
+                Slope::new(-d - rel),
+            ],
+            degenerate: !(ray.origin.is_finite() && ray.dir.is_finite()),
             origin_size: ray.origin.abs().max_element(),
             eps_abs: params.eps_abs.max(0.0),
             eps_rel,
@@ -174,42 +231,31 @@ impl RayClip {
     }
 
     /// [`Aabb::hit_interval`] for this ray: the six faces' intervals intersected (see the
-    /// type), clipped to the trace's range, its ends widened by a relative `1e-5`.
+    /// type), clipped to the trace's range, its ends widened by a relative `1e-5`. Three
+    /// axes at a time (`Vec3A`), with no branch.
     #[inline]
     pub fn clip_box(&self, aabb: &Aabb) -> Option<(f32, f32)> {
-        // Taken off every plane value: the f32 rounding of positions this far out.
-        let rounding = 16.0
-            * f32::EPSILON
-            * (self.origin_size + aabb.min.abs().max(aabb.max.abs()).max_element());
-        // Plane values at the origin, minus the rounding: o - max for the faces facing +,
-        // min - o for those facing -.
-        let up = self.origin - aabb.max - Vec3::splat(rounding);
-        let down = aabb.min - self.origin - Vec3::splat(rounding);
-        let (mut t0, mut t1) = (self.t_min, self.t_max);
-        for k in 0..3 {
-            let d = self.dir[k];
-            for (lo, hi) in [
-                below_threshold(
-                    up[k],
-                    self.eps_abs,
-                    d,
-                    self.inv_dir[k],
-                    d - self.eps_rel,
-                    self.inv_rel_up[k],
-                ),
-                below_threshold(
-                    down[k],
-                    self.eps_abs,
-                    -d,
-                    -self.inv_dir[k],
-                    -d - self.eps_rel,
-                    self.inv_rel_down[k],
-                ),
-            ] {
-                t0 = t0.max(lo);
-                t1 = t1.min(hi);
-            }
+        if self.degenerate {
+            return Some((self.t_min, self.t_max));
         }
+        let (min, max) = (Vec3A::from(aabb.min), Vec3A::from(aabb.max));
+        // Taken off every plane value: the f32 rounding of positions this far out.
+        let size = self.origin_size + min.abs().max(max.abs()).max_element();
+        let rounding = Vec3A::splat(16.0 * f32::EPSILON * size);
+        let eps_abs = Vec3A::splat(self.eps_abs);
+        let up = self.origin - max - rounding;
+        let down = min - self.origin - rounding;
+        let [up_abs, up_rel, down_abs, down_rel] = &self.families;
+        let (t_min, t_max) = (Vec3A::splat(self.t_min), Vec3A::splat(self.t_max));
+        let (lo_a, hi_a) = up_abs.below(up - eps_abs, t_min, t_max);
+        let (lo_b, hi_b) = up_rel.below(up, t_min, t_max);
+        let (lo_c, hi_c) = down_abs.below(down - eps_abs, t_min, t_max);
+        let (lo_d, hi_d) = down_rel.below(down, t_min, t_max);
+        // Per face the hull of its two sets; over the faces, the intersection.
+        let lo = lo_a.min(lo_b).max(lo_c.min(lo_d));
+        let hi = hi_a.max(hi_b).min(hi_c.max(hi_d));
+        let t0 = lo.max_element().max(self.t_min);
+        let t1 = hi.min_element().min(self.t_max);
         widen(t0, t1, self.t_min, self.t_max)
     }
 
@@ -220,16 +266,17 @@ impl RayClip {
         let rounding = 16.0
             * f32::EPSILON
             * (self.origin_size * h.normal.abs().element_sum() + h.height.abs());
-        let a = h.value(self.origin) - rounding;
+        let a = h.value(self.origin.into()) - rounding;
         let b = self.dir.dot(h.normal);
         let b_rel = b - self.eps_rel;
-        let (t0, t1) = below_threshold(a, self.eps_abs, b, b.recip(), b_rel, b_rel.recip());
-        widen(
-            t0.max(self.t_min),
-            t1.min(self.t_max),
-            self.t_min,
-            self.t_max,
-        )
+        let (t0, t1) = below_threshold(
+            a,
+            self.eps_abs,
+            (b, b.recip()),
+            (b_rel, b_rel.recip()),
+            (self.t_min, self.t_max),
+        );
+        widen(t0, t1, self.t_min, self.t_max)
     }
 }
 
@@ -266,6 +313,9 @@ impl HalfSpace {
 fn widen(t0: f32, t1: f32, t_min: f32, t_max: f32) -> Option<(f32, f32)> {
     if t0.is_nan() || t1.is_nan() {
         return Some((t_min, t_max));
+    }
+    if t0 > t1 {
+        return None;
     }
     let t0 = (t0 - WIDEN * t0.abs()).max(t_min);
     let t1 = (t1 + WIDEN * t1.abs()).min(t_max);
