@@ -3,7 +3,9 @@
 use glam::Vec3;
 use lueur_materials::{HemisphereSampling, Material};
 use lueur_sampling::{Sampler, power_heuristic};
-use lueur_sdf_math::{FALLBACK_NORMAL, Ray, Sdf, TraceParams, gradient, gradient_central};
+use lueur_sdf_math::{
+    DistanceField, FALLBACK_NORMAL, Ray, TraceParams, gradient, gradient_central,
+};
 
 use crate::scene::{Hit, Light, Marching, Scene, TraceCounters};
 use crate::{RenderSettings, Strategy};
@@ -105,7 +107,13 @@ impl SurfacePoint {
     /// 6 field evaluations: the tetrahedron gradient (central differences,
     /// 6 evaluations, in naive mode), the distance at the hit and the
     /// distance after the projection.
-    fn new(sdf: &Sdf, hit: Vec3, wo: Vec3, epsilon: f32, march: &March) -> SurfacePoint {
+    fn new<F: DistanceField>(
+        sdf: &F,
+        hit: Vec3,
+        wo: Vec3,
+        epsilon: f32,
+        march: &March,
+    ) -> SurfacePoint {
         let spawn_floor = march.spawn_floor;
         // The difference step is an eighth of the hit shell: finite
         // differences blur a crease (the Death Star's rim) over about h,
@@ -271,8 +279,14 @@ pub(crate) fn radiance(
         }
 
         let wo = -ray.dir;
-        let sdf = &scene.objects[object].sdf;
-        let surface = SurfacePoint::new(sdf, ray.at(t), wo, epsilon, &march);
+        let surface = match scene.marching {
+            Marching::Naive => {
+                SurfacePoint::new(&scene.objects[object].sdf, ray.at(t), wo, epsilon, &march)
+            }
+            Marching::Fast => {
+                SurfacePoint::new(scene.prepared(object), ray.at(t), wo, epsilon, &march)
+            }
+        };
         let (p, n, origin) = (surface.p, surface.n, surface.origin);
         let material = scene.materials[scene.objects[object].material];
 

@@ -11,8 +11,8 @@ use lueur_sampling::{
 use std::cell::Cell;
 
 use lueur_sdf_math::{
-    Aabb, DistanceField, HalfSpace, OVER_RELAXATION, Ray, RayClip, Sdf, TraceOutcome, TraceParams,
-    sphere_trace, sphere_trace_relaxed,
+    Aabb, DistanceField, HalfSpace, OVER_RELAXATION, PreparedSdf, Ray, RayClip, Sdf, TraceOutcome,
+    TraceParams, sphere_trace, sphere_trace_relaxed,
 };
 use smallvec::SmallVec;
 
@@ -143,6 +143,8 @@ pub(crate) struct Geometry {
     lipschitz: f32,
     /// Per object: what a ray is clipped against before it is marched.
     bounds: Vec<ObjectBound>,
+    /// Per object: its transforms folded into one affine map, for fast marching.
+    prepared: Vec<PreparedSdf>,
     /// Objects evaluated at every point: those without a bounding sphere (planes) and
     /// those no dearer than their bound (spheres), first, so that the running minimum is
     /// small before the culled objects are reached.
@@ -250,7 +252,7 @@ impl DistanceField for RayField<'_> {
             {
                 continue;
             }
-            let f = self.geometry.sdfs[c.object as usize].distance(p);
+            let f = self.geometry.prepared[c.object as usize].distance(p);
             if f < d {
                 d = f;
                 nearest = c.object;
@@ -295,6 +297,7 @@ impl Geometry {
             sdfs: objects.iter().map(|o| o.sdf.clone()).collect(),
             lipschitz,
             bounds: objects.iter().map(|o| ObjectBound::of(&o.sdf)).collect(),
+            prepared: objects.iter().map(|o| PreparedSdf::new(&o.sdf)).collect(),
             always,
             culled,
         }
@@ -630,6 +633,11 @@ impl Scene {
                 (outcome, object)
             }
         }
+    }
+
+    /// Object `i`'s field as fast marching evaluates it (its transforms folded).
+    pub(crate) fn prepared(&self, i: usize) -> &PreparedSdf {
+        &self.geometry.prepared[i]
     }
 
     /// The object closest to `p` (after a hit, the one that was hit).

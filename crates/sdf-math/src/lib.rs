@@ -43,6 +43,7 @@ mod blend;
 mod bound;
 mod field;
 mod normal;
+mod prepared;
 mod primitives;
 mod ray;
 mod sdf;
@@ -54,6 +55,7 @@ pub use crate::blend::{smooth_max, smooth_min};
 pub use crate::bound::{Aabb, HalfSpace, RayClip};
 pub use crate::field::DistanceField;
 pub use crate::normal::{FALLBACK_NORMAL, gradient, gradient_central, normal, normal_central};
+pub use crate::prepared::PreparedSdf;
 pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
 pub use crate::trace::{
