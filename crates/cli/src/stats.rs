@@ -12,6 +12,23 @@ pub fn print_stats(out: &RenderOutput) {
         s.samples as f64 / secs / 1e6
     );
     println!("dropped (NaN/Inf){:>14}", s.dropped_samples);
+    // Shares of the threads' time: tracing estimated from every 16th ray
+    // (timed), the film merge measured, the rest (camera rays, shading,
+    // sampling, the point set, scheduling) by difference.
+    let thread_secs = secs * s.threads.max(1) as f64;
+    let tracing = s.rays.camera.tracing_seconds()
+        + s.rays.bounce.tracing_seconds()
+        + s.rays.shadow.tracing_seconds();
+    let film = s.film_time.as_secs_f64();
+    let share = |x: f64| 100.0 * x / thread_secs;
+    println!(
+        "time on {} threads: tracing {:.0}%  shading, normals and sampling {:.0}%  film {:.1}%  (tracing timed on 1 ray in {})",
+        s.threads.max(1),
+        share(tracing),
+        share((thread_secs - tracing - film).max(0.0)),
+        share(film),
+        lueur_integrator::TIMED_EVERY,
+    );
     for (name, c) in [
         ("camera", &s.rays.camera),
         ("bounce", &s.rays.bounce),

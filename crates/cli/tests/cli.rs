@@ -527,4 +527,16 @@ fn stats_print_rays_and_a_steps_histogram() {
             .sum();
         assert!((total - 100.0).abs() < 1.0, "{line}");
     }
+    // The time split: three shares that add up to 100%, tracing a real part of it.
+    let split = out
+        .lines()
+        .find(|l| l.starts_with("time on"))
+        .unwrap_or_else(|| panic!("no time split in {out}"));
+    let shares: Vec<f64> = split
+        .split('%')
+        .filter_map(|part| part.rsplit(' ').next()?.parse::<f64>().ok())
+        .collect();
+    assert_eq!(shares.len(), 3, "{split}");
+    assert!((shares.iter().sum::<f64>() - 100.0).abs() < 2.0, "{split}");
+    assert!(shares[0] > 5.0, "tracing share {split}");
 }

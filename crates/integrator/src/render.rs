@@ -133,6 +133,12 @@ pub struct RenderStats {
     pub samples: u64,
     /// Wall-clock time of the render.
     pub elapsed: Duration,
+    /// Wall-clock time spent merging passes into the film (after the
+    /// tiles, on one thread): the part of a pass that does not run in
+    /// parallel.
+    pub film_time: Duration,
+    /// Threads the render ran on (of the rayon pool in force).
+    pub threads: usize,
 }
 
 impl RenderStats {
@@ -142,6 +148,8 @@ impl RenderStats {
         self.dropped_samples += other.dropped_samples;
         self.samples += other.samples;
         self.elapsed += other.elapsed;
+        self.film_time += other.film_time;
+        self.threads = self.threads.max(other.threads);
     }
 }
 
@@ -250,6 +258,7 @@ pub fn render_pass(
             .map(|p| u64::from(p.n))
             .sum::<u64>();
     }
+    let film_start = Instant::now();
     for (j, samples) in dyadic_blocks(from..until).into_iter().enumerate() {
         // Results are in tile order, each tile row-major.
         let pixel = |i: usize| {
@@ -260,6 +269,8 @@ pub fn render_pass(
         film.append_with(samples, pixel)
             .expect("a pass's blocks follow the film's");
     }
+    stats.film_time = film_start.elapsed();
+    stats.threads = rayon::current_num_threads();
     stats.elapsed = start.elapsed();
     Ok(Some(stats))
 }

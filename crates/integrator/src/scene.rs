@@ -9,6 +9,7 @@ use lueur_sampling::{
     sample_sphere_light, sphere_light_pdf,
 };
 use std::cell::Cell;
+use std::time::Instant;
 
 use lueur_sdf_math::{
     Aabb, DistanceField, HalfSpace, OVER_RELAXATION, PreparedSdf, Ray, RayClip, Sdf, TraceOutcome,
@@ -434,7 +435,16 @@ pub struct TraceCounters {
     /// `2^i ..= 2^(i+1) - 1` steps (bucket 0 also counts rays of 0 steps,
     /// the last one every ray of 512 steps or more).
     pub steps_histogram: [u64; STEP_BUCKETS],
+    /// Rays whose tracing was timed: one in [`TIMED_EVERY`], so that the
+    /// clock (tens of nanoseconds a reading) costs well under 1% of a render.
+    pub timed_rays: u64,
+    /// Wall time spent tracing the timed rays (bounds, marching, lights), in
+    /// nanoseconds. Never affects the image.
+    pub timed_nanos: u64,
 }
+
+/// One ray in this many is timed (see [`TraceCounters::timed_nanos`]).
+pub const TIMED_EVERY: u64 = 16;
 
 /// Buckets of [`TraceCounters::steps_histogram`].
 pub const STEP_BUCKETS: usize = 10;
@@ -453,9 +463,35 @@ impl TraceCounters {
         }
     }
 
+    /// Estimated wall time spent tracing every ray: the timed rays' time
+    /// scaled by the share they are of all rays.
+    pub fn tracing_seconds(&self) -> f64 {
+        if self.timed_rays == 0 {
+            return 0.0;
+        }
+        self.timed_nanos as f64 * 1e-9 * self.rays as f64 / self.timed_rays as f64
+    }
+
+    /// Starts the clock if this ray is one of the timed ones (decided by
+    /// the ray count, so deterministically and evenly spread).
+    #[inline]
+    fn clock(&self) -> Option<Instant> {
+        (self.rays % TIMED_EVERY == 0).then(Instant::now)
+    }
+
+    #[inline]
+    fn stop(&mut self, clock: Option<Instant>) {
+        if let Some(start) = clock {
+            self.timed_rays += 1;
+            self.timed_nanos += start.elapsed().as_nanos() as u64;
+        }
+    }
+
     /// Adds another set of counters.
     pub fn merge(&mut self, o: &TraceCounters) {
         self.rays += o.rays;
+        self.timed_rays += o.timed_rays;
+        self.timed_nanos += o.timed_nanos;
         self.steps += o.steps;
         self.hits += o.hits;
         self.misses += o.misses;
@@ -687,6 +723,19 @@ impl Scene {
         counters: &mut TraceCounters,
         maybe_inside: bool,
     ) -> Option<Hit> {
+        let clock = counters.clock();
+        let hit = self.intersect_untimed(ray, params, counters, maybe_inside);
+        counters.stop(clock);
+        hit
+    }
+
+    fn intersect_untimed(
+        &self,
+        ray: &Ray,
+        params: &TraceParams,
+        counters: &mut TraceCounters,
+        maybe_inside: bool,
+    ) -> Option<Hit> {
         let light_hit = self.intersect_lights(ray, params.t_max, None);
         let t_max = light_hit.map_or(params.t_max, |(t, _)| t);
         let mut surface = None;
@@ -721,6 +770,20 @@ impl Scene {
     /// Whether the segment from `ray.origin` along `ray.dir` is free of
     /// objects and of lights other than `target` up to `distance`.
     pub(crate) fn unoccluded(
+        &self,
+        ray: &Ray,
+        distance: f32,
+        target: Option<usize>,
+        params: &TraceParams,
+        counters: &mut TraceCounters,
+    ) -> bool {
+        let clock = counters.clock();
+        let free = self.unoccluded_untimed(ray, distance, target, params, counters);
+        counters.stop(clock);
+        free
+    }
+
+    fn unoccluded_untimed(
         &self,
         ray: &Ray,
         distance: f32,

@@ -6,6 +6,11 @@
 //! tracer has no virtual calls and no allocation. Anything else that wants to be traced
 //! implements the two-method [`DistanceField`] trait.
 //!
+//! Around the tree: bounds a tracer can clip rays against before marching them
+//! ([`Sdf::bounding_box`], [`Sdf::bounding_half_space`], with [`RayClip`] giving the exact
+//! range of a ray where a hit is possible), and [`PreparedSdf`], the same field with its
+//! transforms folded into one affine map for hot loops.
+//!
 //! Contract: **every `Sdf` is Lipschitz with the bound it reports**,
 //! `|f(p) - f(q)| <= lipschitz() * |p - q|`, for every finite parameter value. That is
 //! what makes [`sphere_trace`] (Hart 1996) safe. Where a node's value is also the exact
