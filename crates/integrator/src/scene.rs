@@ -443,7 +443,8 @@ pub struct TraceCounters {
     pub timed_nanos: u64,
 }
 
-/// One ray in this many is timed (see [`TraceCounters::timed_nanos`]).
+/// One ray in this many is timed (see [`TraceCounters::timed_nanos`]); a
+/// power of two.
 pub const TIMED_EVERY: u64 = 16;
 
 /// Buckets of [`TraceCounters::steps_histogram`].
@@ -476,7 +477,8 @@ impl TraceCounters {
     /// the ray count, so deterministically and evenly spread).
     #[inline]
     fn clock(&self) -> Option<Instant> {
-        (self.rays % TIMED_EVERY == 0).then(Instant::now)
+        // A mask, not `is_multiple_of` (Rust 1.87; the workspace supports 1.85).
+        (self.rays & (TIMED_EVERY - 1) == 0).then(Instant::now)
     }
 
     #[inline]
