@@ -87,10 +87,11 @@ impl March {
 /// A hit made usable for shading: the tracer stops anywhere in a shell of
 /// width `epsilon` around the surface (a quarter pixel for camera rays), so
 /// shading there would measure light from the wrong point. One Newton step
-/// along the gradient moves the point onto the surface; rays leave from just
-/// above it, by an offset that covers what the projection left over.
-/// Sampling, pdfs and MIS weights use `p`; only ray origins use `origin`
-/// (pbrt-v4's split between the interaction point and `SpawnRay`).
+/// *along the ray* moves the point onto the surface where the ray crosses
+/// it; rays leave from just above it, by an offset that covers what the
+/// step left over. Sampling, pdfs and MIS weights use `p`; only ray origins
+/// use `origin` (pbrt-v4's split between the interaction point and
+/// `SpawnRay`).
 pub(crate) struct SurfacePoint {
     /// The point on the surface.
     pub p: Vec3,
@@ -104,9 +105,21 @@ pub(crate) struct SurfacePoint {
 }
 
 impl SurfacePoint {
-    /// 6 field evaluations: the tetrahedron gradient (central differences,
-    /// 6 evaluations, in naive mode), the distance at the hit and the
-    /// distance after the projection.
+    /// 7 field evaluations (9 where the ray grazes): the distance at the hit
+    /// and one step further along the ray, the tetrahedron gradient at the
+    /// corrected point (central differences, 6 evaluations, in naive mode),
+    /// and the distance there.
+    ///
+    /// Why along the ray and not along the normal: projecting a point of the
+    /// shell onto the surface along the normal moves it sideways by up to
+    /// `epsilon tan(theta)`, and with it the normal and everything a mirror
+    /// reflects, by an amount that depends on where in the shell the tracer
+    /// happened to stop. Measured: the light's reflection in the donut's
+    /// mirror spheres came out 10% brighter with fast marching than naive
+    /// (the image mean +1.0%, z = 9) only because the two stopped at
+    /// different depths of the shell. Along the ray, the shading point is
+    /// the ray's own intersection (to second order) wherever the tracer
+    /// stopped, and the normal is taken there.
     fn new<F: DistanceField>(
         sdf: &F,
         hit: Vec3,
@@ -115,6 +128,7 @@ impl SurfacePoint {
         march: &March,
     ) -> SurfacePoint {
         let spawn_floor = march.spawn_floor;
+        let reach = 4.0 * epsilon.max(spawn_floor);
         // The difference step is an eighth of the hit shell: finite
         // differences blur a crease (the Death Star's rim) over about h,
         // and at the shell's width (a quarter pixel for camera rays) that
@@ -123,10 +137,21 @@ impl SurfacePoint {
         // the two at 32x32, 256 spp). Smooth surfaces do not care: their
         // gradient is exact at any h.
         let h = (epsilon * 0.125).max(spawn_floor);
+        // Newton along the ray: f(hit + s dir) = 0 with the slope of f along
+        // the ray by a forward difference. Taken only where the ray meets
+        // the surface at more than ~75 degrees from grazing (the slope is at
+        // least a quarter of a unit gradient) and the step stays within a
+        // few shells; elsewhere the normal projection below does the work.
+        let dir = -wo;
+        let f_hit = sdf.distance(hit);
+        let slope = (sdf.distance(hit + dir * h) - f_hit) / h;
+        let along = -f_hit / slope;
+        let on_ray = slope.abs() >= 0.25 && along.is_finite() && along.abs() <= reach;
+        let start = if on_ray { hit + dir * along } else { hit };
         let grad = if march.central_normals {
-            gradient_central(sdf, hit, h)
+            gradient_central(sdf, start, h)
         } else {
-            gradient(sdf, hit, h)
+            gradient(sdf, start, h)
         };
         let g = grad.length();
         let n_geo = if g.is_finite() && g > 0.0 {
@@ -134,14 +159,19 @@ impl SurfacePoint {
         } else {
             FALLBACK_NORMAL
         };
-        // f / |grad f| is the distance to first order, also for bounds (L > 1).
-        let step = sdf.distance(hit) / g;
-        let p = if step.is_finite() && step.abs() <= 4.0 * epsilon.max(spawn_floor) {
-            hit - n_geo * step
+        // What is left (second order on the ray; the whole shell where the
+        // ray grazes) goes along the normal: f / |grad f| is the distance to
+        // first order, also for bounds (L > 1).
+        let f_start = sdf.distance(start);
+        let step = f_start / g;
+        let (p, residual) = if on_ray {
+            (start, (f_start / g.max(1e-3)).abs())
+        } else if step.is_finite() && step.abs() <= reach {
+            let p = start - n_geo * step;
+            (p, (sdf.distance(p) / g.max(1e-3)).abs())
         } else {
-            hit
+            (start, (f_start / g.max(1e-3)).abs())
         };
-        let residual = (sdf.distance(p) / g.max(1e-3)).abs();
         let inside = n_geo.dot(wo) < 0.0;
         let n = if inside { -n_geo } else { n_geo };
         let offset = spawn_floor.max(if residual.is_finite() {
@@ -480,4 +510,72 @@ fn next_event(
     let bsdf_pdf = material.pdf(wo, es.wi, n, HemisphereSampling::Cosine);
     let w = power_heuristic(1.0, es.pdf, 1.0, bsdf_pdf);
     f * es.radiance * cos * w / es.pdf
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::ray_sphere;
+    use lueur_sdf_math::Sdf;
+
+    /// A march with the given hit shell and a tiny spawn offset.
+    fn march(central_normals: bool) -> March {
+        let params = TraceParams::default();
+        March {
+            camera: params,
+            secondary: params,
+            spawn_floor: 1e-7,
+            camera_inside: false,
+            central_normals,
+        }
+    }
+
+    /// Where along `ray` the sphere's field equals `level` (bisection).
+    fn t_at_level(sdf: &Sdf, ray: &Ray, level: f32, mut lo: f32, mut hi: f32) -> f32 {
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if sdf.distance(ray.at(mid)) > level {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+
+    /// Wherever in the shell the tracer stopped, the shading point is the
+    /// ray's own intersection and the normal the one there. Projecting along
+    /// the normal instead (the old way) is off by up to `epsilon tan(theta)`
+    /// sideways: 1.7 shells at 60 degrees, which this test would catch.
+    #[test]
+    fn shading_point_is_on_the_ray_wherever_the_tracer_stopped() {
+        let (radius, epsilon) = (0.38f32, 0.01f32);
+        let sdf = Sdf::sphere(radius);
+        for central in [false, true] {
+            // Head-on, 45 and 60 degrees from the normal.
+            for offset in [0.0f32, 0.27, 0.33] {
+                let origin = Vec3::new(offset, 0.0, 5.0);
+                let ray = Ray::new(origin, -Vec3::Z);
+                let t_true = ray_sphere(&ray, Vec3::ZERO, radius).unwrap();
+                let x_true = ray.at(t_true);
+                let n_true = x_true / radius;
+                for depth in [0.0f32, 0.3, 0.6, 0.95] {
+                    let t_hit = t_at_level(&sdf, &ray, depth * epsilon, 0.0, t_true);
+                    let s =
+                        SurfacePoint::new(&sdf, ray.at(t_hit), -ray.dir, epsilon, &march(central));
+                    let off = (s.p - x_true).length();
+                    assert!(
+                        off < 0.1 * epsilon,
+                        "central {central}, offset {offset}, depth {depth}: {off} from the intersection"
+                    );
+                    let angle = s.n.dot(n_true).clamp(-1.0, 1.0).acos();
+                    assert!(
+                        angle < 0.1 * epsilon / radius,
+                        "central {central}, offset {offset}, depth {depth}: normal off by {angle}"
+                    );
+                    assert!((s.origin - s.p).dot(s.n) > 0.0);
+                }
+            }
+        }
+    }
 }
