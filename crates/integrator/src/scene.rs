@@ -726,18 +726,6 @@ impl Scene {
         maybe_inside: bool,
     ) -> Option<Hit> {
         let clock = counters.clock();
-        let hit = self.intersect_untimed(ray, params, counters, maybe_inside);
-        counters.stop(clock);
-        hit
-    }
-
-    fn intersect_untimed(
-        &self,
-        ray: &Ray,
-        params: &TraceParams,
-        counters: &mut TraceCounters,
-        maybe_inside: bool,
-    ) -> Option<Hit> {
         let light_hit = self.intersect_lights(ray, params.t_max, None);
         let t_max = light_hit.map_or(params.t_max, |(t, _)| t);
         let mut surface = None;
@@ -766,6 +754,7 @@ impl Scene {
         } else {
             counters.rays += 1;
         }
+        counters.stop(clock);
         surface.or(light_hit.map(|(t, light)| Hit::Light { t, light }))
     }
 
@@ -780,33 +769,24 @@ impl Scene {
         counters: &mut TraceCounters,
     ) -> bool {
         let clock = counters.clock();
-        let free = self.unoccluded_untimed(ray, distance, target, params, counters);
+        let free = 'free: {
+            // Stop short of the light's surface so that its own geometry (for
+            // lights that are objects too) does not occlude it.
+            let t_max = (distance * (1.0 - 1e-4) - params.eps_abs).min(params.t_max);
+            if let Some((_, l)) = self.intersect_lights(ray, t_max, target)
+                && Some(l) != target
+            {
+                break 'free false;
+            }
+            if self.objects.is_empty() || t_max <= params.t_min {
+                break 'free true;
+            }
+            let (outcome, _) = self.trace(ray, &TraceParams { t_max, ..*params });
+            counters.record(&outcome);
+            outcome.hit_t().is_none()
+        };
         counters.stop(clock);
         free
-    }
-
-    fn unoccluded_untimed(
-        &self,
-        ray: &Ray,
-        distance: f32,
-        target: Option<usize>,
-        params: &TraceParams,
-        counters: &mut TraceCounters,
-    ) -> bool {
-        // Stop short of the light's surface so that its own geometry (for
-        // lights that are objects too) does not occlude it.
-        let t_max = (distance * (1.0 - 1e-4) - params.eps_abs).min(params.t_max);
-        if let Some((_, l)) = self.intersect_lights(ray, t_max, target)
-            && Some(l) != target
-        {
-            return false;
-        }
-        if self.objects.is_empty() || t_max <= params.t_min {
-            return true;
-        }
-        let (outcome, _) = self.trace(ray, &TraceParams { t_max, ..*params });
-        counters.record(&outcome);
-        outcome.hit_t().is_none()
     }
 
     fn intersect_lights(&self, ray: &Ray, t_max: f32, skip: Option<usize>) -> Option<(f32, usize)> {
