@@ -64,7 +64,7 @@ fn white_furnace_is_uniformly_one() {
             (mean - 1.0).abs() < 4.0 * stderr + 1e-6,
             "{strategy}: image mean {mean} +- {stderr}"
         );
-        for p in film.pixels().iter() {
+        for p in film.pixels() {
             let se = p.variance_of_mean().max_element().sqrt();
             let err = (p.mean - Vec3::ONE).abs().max_element();
             assert!(

@@ -118,7 +118,7 @@ fn reject(text: &str) -> SceneFileError {
 
 fn render_file(file: &SceneFile) -> RenderOutput {
     let out = run(&file.scene, &file.settings);
-    for p in out.film.pixels().iter() {
+    for p in out.film.pixels() {
         assert!(p.mean.is_finite() && p.mean.min_element() >= 0.0, "{p:?}");
     }
     out
@@ -362,7 +362,7 @@ fn tiny_images_and_sample_counts_render() {
         let out = run(&file.scene, &settings);
         assert_eq!((out.film.width(), out.film.height()), (w, h));
         assert_eq!(out.film.spp(), spp);
-        for p in out.film.pixels().iter() {
+        for p in out.film.pixels() {
             assert_eq!(p.n, spp);
             assert!(p.mean.is_finite() && p.variance_of_mean().is_finite());
         }
@@ -408,7 +408,7 @@ radiance = [7.0, 7.0, 7.0]
             (Vec3::splat(7.0), Vec3::ZERO),
             "{strategy:?}"
         );
-        for p in out.film.pixels().iter() {
+        for p in out.film.pixels() {
             assert!(p.mean.cmple(Vec3::splat(7.0)).all());
         }
         file.settings.max_depth = 1;

@@ -60,9 +60,9 @@ fn passes_add_up_to_the_single_pass_image_bit_for_bit() {
         let mut film = Film::new(settings.width, settings.height);
         let never = AtomicBool::new(false);
         for until in [1, 2, 4, 8] {
-            render_pass(&file.scene, &settings, &mut film, until, &never, &|_| {})
-                .unwrap()
-                .expect("not cancelled");
+            let pass =
+                render_pass(&file.scene, &settings, &mut film, until, &never, &|_| {}).unwrap();
+            assert!(pass.complete);
             assert_eq!(film.spp(), until);
         }
         assert!(film == whole, "{sampler}: passes differ from one pass");
@@ -95,9 +95,9 @@ fn shards_merge_into_the_single_render_bit_for_bit() {
             let mut until = range.start;
             while until < range.end {
                 until = (until + step).min(range.end);
-                render_pass(&file.scene, &settings, &mut film, until, &never, &|_| {})
-                    .unwrap()
-                    .expect("not cancelled");
+                let pass =
+                    render_pass(&file.scene, &settings, &mut film, until, &never, &|_| {}).unwrap();
+                assert!(pass.complete);
             }
             film
         };
@@ -111,9 +111,10 @@ fn shards_merge_into_the_single_render_bit_for_bit() {
     }
 }
 
-/// A cancelled pass leaves the film exactly as it was.
+/// A pass cancelled before any tile finished leaves the film exactly as it
+/// was.
 #[test]
-fn a_cancelled_pass_changes_nothing() {
+fn a_pass_cancelled_at_once_changes_nothing() {
     use std::sync::atomic::AtomicBool;
 
     use lueur::integrator::{Film, render_pass};
@@ -122,7 +123,7 @@ fn a_cancelled_pass_changes_nothing() {
     let mut settings = file.settings.clone();
     (settings.width, settings.height, settings.spp) = (16, 16, 4);
     let mut film = Film::new(16, 16);
-    render_pass(
+    let first = render_pass(
         &file.scene,
         &settings,
         &mut film,
@@ -130,8 +131,8 @@ fn a_cancelled_pass_changes_nothing() {
         &AtomicBool::new(false),
         &|_| {},
     )
-    .unwrap()
     .unwrap();
+    assert!(first.complete);
     let before = film.clone();
     let cancelled = render_pass(
         &file.scene,
@@ -142,10 +143,129 @@ fn a_cancelled_pass_changes_nothing() {
         &|_| {},
     )
     .unwrap();
-    assert!(cancelled.is_none());
-    assert!(film == before && film.spp() == 2);
+    assert!(!cancelled.complete && cancelled.stats.samples == 0);
+    assert!(film == before && film.spp() == 2 && film.unfinished_pass().is_none());
     // A pass that adds nothing, or overshoots the render's spp, is refused.
     let never = AtomicBool::new(false);
     assert!(render_pass(&file.scene, &settings, &mut film, 2, &never, &|_| {}).is_err());
     assert!(render_pass(&file.scene, &settings, &mut film, 5, &never, &|_| {}).is_err());
+}
+
+/// A pass cancelled midway keeps the tiles it finished, bit for bit as the
+/// whole pass would have left them, and the other tiles as they were; such
+/// a film says so, and refuses to be saved, merged or extended.
+#[test]
+fn a_pass_cancelled_midway_keeps_its_finished_tiles() {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+    use lueur::integrator::{Film, render_pass};
+
+    let file = shipped("cornell-spheres");
+    let mut settings = file.settings.clone();
+    // 4 x 3 tiles of 16 pixels, the last column and row of them cut short.
+    (settings.width, settings.height, settings.spp) = (60, 40, 8);
+    let never = AtomicBool::new(false);
+    let mut film = Film::new(60, 40);
+    for until in [1, 3] {
+        render_pass(&file.scene, &settings, &mut film, until, &never, &|_| {}).unwrap();
+    }
+    let before = film.clone();
+    let mut whole = film.clone();
+    render_pass(&file.scene, &settings, &mut whole, 8, &never, &|_| {}).unwrap();
+
+    let cancel = AtomicBool::new(false);
+    let tiles_done = AtomicUsize::new(0);
+    let stop_after_five = |_| {
+        if tiles_done.fetch_add(1, Ordering::SeqCst) + 1 == 5 {
+            cancel.store(true, Ordering::SeqCst);
+        }
+    };
+    let pass = render_pass(
+        &file.scene,
+        &settings,
+        &mut film,
+        8,
+        &cancel,
+        &stop_after_five,
+    )
+    .unwrap();
+    assert!(!pass.complete);
+    let (samples, share) = film.unfinished_pass().expect("unfinished");
+    assert_eq!(samples, 3..8);
+    assert_eq!(
+        film.spp(),
+        3,
+        "the whole-film spp is the last complete pass's"
+    );
+
+    let mut at_8 = 0;
+    for y in 0..40 {
+        for x in 0..60 {
+            let p = film.pixel(x, y);
+            let tile_corner = film.pixel(x / 16 * 16, y / 16 * 16);
+            if p == whole.pixel(x, y) && tile_corner == whole.pixel(x / 16 * 16, y / 16 * 16) {
+                at_8 += 1;
+            } else {
+                assert_eq!(p, before.pixel(x, y), "pixel ({x}, {y}) is neither");
+            }
+        }
+    }
+    assert_eq!(at_8 as f64, share * 2400.0);
+    assert!(
+        at_8 >= 5 * 12 * 8,
+        "at least the 5 tiles finished first: {at_8}"
+    );
+    assert!(at_8 < 2400, "the cancel stopped the pass");
+    assert_eq!(
+        pass.stats.samples,
+        5 * at_8 as u64,
+        "the stats count the finished tiles' samples"
+    );
+
+    assert!(film.blocks().is_err());
+    assert!(Film::merge(vec![film.clone()]).is_err());
+    assert!(render_pass(&file.scene, &settings, &mut film, 8, &never, &|_| {}).is_err());
+}
+
+/// A film sealed at its end folds its blocks into one image on the pass
+/// that reaches it: the image is bit-identical to the unsealed film's,
+/// from a fresh start (0..16 then 16..24) as from a film that already held
+/// two blocks (0..16, 16..20, resumed to 24); the sealed film refuses to be
+/// saved, merged or extended.
+#[test]
+fn a_sealed_film_has_the_unsealed_image_bit_for_bit() {
+    use std::sync::atomic::AtomicBool;
+
+    use lueur::integrator::{Film, FilmError, render_pass};
+
+    let file = shipped("donut-mirrors");
+    let mut settings = file.settings.clone();
+    (settings.width, settings.height, settings.spp) = (20, 18, 24);
+    let never = AtomicBool::new(false);
+    let run = |film: &mut Film, passes: &[u32]| {
+        for &until in passes {
+            let pass = render_pass(&file.scene, &settings, film, until, &never, &|_| {}).unwrap();
+            assert!(pass.complete);
+        }
+    };
+    for passes in [&[1, 2, 4, 8, 16, 24][..], &[16, 20, 24], &[24]] {
+        let mut open = Film::new(20, 18);
+        run(&mut open, passes);
+        let mut sealed = Film::new(20, 18).sealed_at(24);
+        run(&mut sealed, passes);
+        assert!(open.blocks().unwrap().count() == 2 && !open.is_sealed());
+        assert!(sealed.is_sealed(), "{passes:?}");
+        assert!(
+            sealed.pixels().eq(open.pixels()),
+            "{passes:?}: the sealed image differs"
+        );
+        assert_eq!(sealed.samples(), 0..24);
+        assert!(matches!(sealed.blocks().err(), Some(FilmError::Sealed(_))));
+        assert!(Film::merge(vec![sealed.clone()]).is_err());
+    }
+    // A film sealed at the render's end that stops short of it (a time
+    // budget) is an ordinary film.
+    let mut short = Film::new(20, 18).sealed_at(24);
+    run(&mut short, &[1, 2, 4]);
+    assert!(!short.is_sealed() && short.blocks().is_ok());
 }

@@ -60,7 +60,7 @@ pub fn save(path: &Path, film: &Film, scene_text: &str, fingerprint: &str) -> Re
     }
     let size = (film.width() as usize, film.height() as usize);
     let mut layers = Vec::new();
-    for (samples, px) in film.blocks() {
+    for (samples, px) in film.blocks()? {
         let f32_channel = |name: &str, f: &dyn Fn(&PixelStats) -> f32| {
             AnyChannel::new(name, FlatSamples::F32(px.iter().map(f).collect()))
         };

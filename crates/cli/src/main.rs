@@ -164,22 +164,45 @@ fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
 
 /// The render was stopped by a signal; what was complete has been written.
 #[derive(Debug)]
-struct Interrupted(u32);
+struct Interrupted {
+    /// Samples per pixel that every pixel has.
+    spp: u32,
+    /// The interrupted pass's end and the share of pixels that reached it.
+    unfinished: Option<(u32, f64)>,
+    /// The checkpoint, which holds the last complete pass.
+    checkpoint: Option<PathBuf>,
+}
 
 impl std::fmt::Display for Interrupted {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        if self.0 == 0 {
-            write!(
+        if self.spp == 0 {
+            return write!(
                 f,
                 "interrupted before the first pass completed; nothing written"
-            )
-        } else {
+            );
+        }
+        write!(
+            f,
+            "interrupted: wrote the {} spp completed before the signal",
+            self.spp
+        )?;
+        if let Some((end, share)) = self.unfinished {
             write!(
                 f,
-                "interrupted: wrote the {} spp completed before the signal",
-                self.0
-            )
+                ", and {end} spp in the {:.0}% of the pixels whose tiles finished the pass in \
+                 progress",
+                100.0 * share
+            )?;
         }
+        if let Some(path) = &self.checkpoint {
+            write!(
+                f,
+                "; {} holds the {} spp (resume from it)",
+                path.display(),
+                self.spp
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -310,6 +333,12 @@ fn run_render(args: RenderArgs) -> Result<()> {
         }
         None => Film::starting_at(settings.width, settings.height, range.start),
     };
+    // Without a checkpoint nobody will extend the film: it can keep one
+    // image instead of one per dyadic block (two at 24 spp, three at 100).
+    let film = match args.checkpoint {
+        Some(_) => film,
+        None => film.sealed_at(range.end),
+    };
     bar.inc(pixels * u64::from(film.spp().min(range.end - range.start)));
     let mut after_pass = |film: &Film| match &args.checkpoint {
         Some(path) => checkpoint::save(path, film, &text, &fingerprint)
@@ -339,9 +368,18 @@ fn run_render(args: RenderArgs) -> Result<()> {
     }?;
     bar.finish_and_clear();
     let output: RenderOutput = output;
+    let interrupted = || Interrupted {
+        spp: output.film.spp(),
+        unfinished: output
+            .film
+            .unfinished_pass()
+            .map(|(samples, share)| (samples.end - output.film.samples().start, share)),
+        checkpoint: args.checkpoint.clone(),
+    };
     if output.film.spp() == 0 {
-        // Interrupted during the first pass: nothing whole to write.
-        return Err(Interrupted(0).into());
+        // Interrupted during the first pass: a partly black image is of no
+        // use to anyone.
+        return Err(interrupted().into());
     }
 
     if let (Some(out), Some(format)) = (&out, format) {
@@ -388,7 +426,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
             output.film.spp(),
             range.end - range.start
         ),
-        progressive::Stop::Interrupted => return Err(Interrupted(output.film.spp()).into()),
+        progressive::Stop::Interrupted => return Err(interrupted().into()),
     }
     Ok(())
 }

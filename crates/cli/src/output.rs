@@ -71,8 +71,6 @@ fn write_exr(path: &Path, film: &Film) -> Result<()> {
     use exr::prelude::*;
     // Pixels are read straight from the film's statistics as the writer
     // asks for them, so a 4K film is not copied into channel images first.
-    let pixels = film.pixels();
-    let width = film.width() as usize;
     let channels = SpecificChannels::build()
         .with_channel("R")
         .with_channel("G")
@@ -81,7 +79,7 @@ fn write_exr(path: &Path, film: &Film) -> Result<()> {
         .with_channel("variance.G")
         .with_channel("variance.B")
         .with_pixel_fn(|pos: Vec2<usize>| {
-            let p: &PixelStats = &pixels[pos.y() * width + pos.x()];
+            let p: PixelStats = film.pixel(pos.x() as u32, pos.y() as u32);
             let v = p.variance_of_mean();
             (p.mean.x, p.mean.y, p.mean.z, v.x, v.y, v.z)
         });

@@ -1,14 +1,16 @@
 //! Progressive rendering for the CLI: passes of 1, 1, 2, 4, ... samples per
-//! pixel (pbrt's schedule), so the film always holds a whole number of
-//! samples per pixel and a render can stop after any pass, on a signal, a
-//! time budget or an error target, without losing what it paid for.
+//! pixel (pbrt's schedule), so the film holds a whole number of samples per
+//! pixel after every pass and a render can stop there, on a time budget or
+//! an error target. A signal stops it sooner, after the tiles in flight:
+//! every finished tile is kept, so it loses no more than a tile per thread.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
 use lueur_integrator::{Film, RenderOutput, RenderSettings, RenderStats, Scene, render_pass};
 
-/// Set by SIGINT, SIGTERM or SIGHUP: the current pass is abandoned.
+/// Set by SIGINT, SIGTERM or SIGHUP: the current pass stops after the
+/// tiles it finished.
 static CANCEL: AtomicBool = AtomicBool::new(false);
 /// Signals received so far; the second one exits at once.
 static SIGNALS: AtomicUsize = AtomicUsize::new(0);
@@ -26,7 +28,7 @@ pub fn install_signal_handler() -> anyhow::Result<()> {
             std::process::exit(i32::from(EXIT_INTERRUPTED));
         }
         CANCEL.store(true, Ordering::SeqCst);
-        eprintln!("\ninterrupt: finishing with the last complete pass (again to exit now)");
+        eprintln!("\ninterrupt: writing the tiles rendered so far (again to exit now)");
     })?;
     Ok(())
 }
@@ -46,7 +48,8 @@ pub struct Limits {
 pub enum Stop {
     /// All `spp` samples per pixel were rendered.
     Complete,
-    /// A signal arrived; the film holds the passes completed before it.
+    /// A signal arrived; the film holds the passes completed before it, and
+    /// the tiles of the next one that finished (it may be unfinished).
     Interrupted,
     /// The next pass would have ended past the time budget.
     TimeBudget,
@@ -84,9 +87,10 @@ pub fn render(
     let resumed_at = film.spp();
     let mut until = next_end(&film);
     loop {
-        match render_pass(scene, settings, &mut film, until, &CANCEL, progress)? {
-            Some(pass) => stats.merge(&pass),
-            None => return Ok((RenderOutput { film, stats }, Stop::Interrupted)),
+        let pass = render_pass(scene, settings, &mut film, until, &CANCEL, progress)?;
+        stats.merge(&pass.stats);
+        if !pass.complete {
+            return Ok((RenderOutput { film, stats }, Stop::Interrupted));
         }
         after_pass(&film)?;
         if film.samples().end >= end {

@@ -14,11 +14,17 @@
 //! machines, every block ends up with the same bits, so resuming and
 //! merging are exact. (Pairwise merging is also more accurate than a
 //! running sum, as pairwise summation is.)
+//!
+//! Memory is the other constraint (a 4K image of statistics is 232 MB):
+//! a pass is merged in tile by tile as its tiles finish, never held as a
+//! second image, and a film that nobody will extend can be *sealed* so
+//! that its last pass folds the blocks into one image.
 
-use std::borrow::Cow;
 use std::ops::Range;
+use std::sync::Mutex;
 
-use glam::Vec3;
+use glam::{UVec2, Vec3};
+use smallvec::SmallVec;
 
 /// Mean and variance of one pixel's estimates over a set of samples, per
 /// RGB channel.
@@ -179,13 +185,6 @@ fn siblings(a: &Range<u32>, b: &Range<u32>) -> bool {
         && u64::from(a.start).is_multiple_of(2 * u64::from(len))
 }
 
-/// One dyadic block of sample indices and every pixel's statistics over it.
-#[derive(Clone, Debug, PartialEq)]
-struct Block {
-    samples: Range<u32>,
-    pixels: Vec<PixelStats>,
-}
-
 /// Why saved or merged statistics do not make a film.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FilmError {
@@ -204,10 +203,44 @@ pub enum FilmError {
     /// Nothing to merge.
     #[error("no films to merge")]
     Empty,
+    /// A film whose last pass was interrupted: some tiles hold more samples
+    /// than others, so it has no single range to save, merge or extend.
+    #[error(
+        "the pass of samples {0:?} was interrupted after some tiles: the film is not a whole \
+         number of samples per pixel"
+    )]
+    UnfinishedPass(Range<u32>),
+    /// A film that merged its blocks into one image on reaching its end
+    /// (see [`Film::sealed_at`]).
+    #[error(
+        "the film of samples {0:?} kept only its image: it cannot be saved, merged or extended"
+    )]
+    Sealed(Range<u32>),
+}
+
+/// A pass cancelled after some of its tiles were merged in: those tiles
+/// hold the blocks of `after`, the others still those of the film's
+/// `ranges`.
+#[derive(Clone, Debug, PartialEq)]
+struct UnfinishedPass {
+    /// The pass's sample indices.
+    samples: Range<u32>,
+    /// The block ranges of the tiles that finished it.
+    after: Vec<Range<u32>>,
+    /// Side of the square tiles.
+    tile: u32,
+    /// Per tile, row-major: whether it finished the pass.
+    done: Vec<bool>,
 }
 
 /// An image of per-pixel statistics over a range of sample indices,
 /// row-major, row 0 at the top.
+///
+/// Passes are merged in tile by tile as the tiles finish (the film never
+/// exists twice: at 4K one image of statistics is 232 MB). So a cancelled
+/// pass leaves the tiles it finished with its samples and the others
+/// without: an *unfinished* film, which can be looked at (every pixel still
+/// holds a whole number of samples) but not saved, merged or extended.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     width: u32,
@@ -215,7 +248,138 @@ pub struct Film {
     /// First sample index (0 unless the film is a shard).
     start: u32,
     /// The [`dyadic_blocks`] of `start..end`, in order.
-    blocks: Vec<Block>,
+    ranges: Vec<Range<u32>>,
+    /// Per block, every pixel's statistics over it. Holds more images than
+    /// `ranges` while a pass is unfinished (those of its `after`).
+    images: Vec<Vec<PixelStats>>,
+    unfinished: Option<UnfinishedPass>,
+    /// The pass that reaches this sample index folds the blocks into one
+    /// image (see [`Film::sealed_at`]).
+    seal_at: Option<u32>,
+    /// Whether it has: `ranges` is then one block, not a dyadic tiling.
+    sealed: bool,
+}
+
+/// How a pass's blocks join a film's: computed once from the ranges, then
+/// applied to every pixel with the same merges, in the same order, as
+/// [`Film::append`] applies to whole images.
+#[derive(Clone, Debug)]
+pub(crate) struct PassPlan {
+    samples: Range<u32>,
+    /// The pass's own blocks, as a tile delivers them.
+    pass: Vec<Range<u32>>,
+    /// The film's blocks below this position are not touched.
+    keep: usize,
+    /// Whether the blocks after the pass are folded into one image.
+    seal: bool,
+    before: Vec<Range<u32>>,
+    after: Vec<Range<u32>>,
+}
+
+/// One block joined to a stack of blocks as a binary counter carries:
+/// merged into the top when they are siblings, pushed otherwise, then the
+/// top merged into the one below while they are siblings. Returns the
+/// lowest position written.
+fn join<T: Copy>(
+    stack: &mut SmallVec<[(Range<u32>, T); 8]>,
+    block: (Range<u32>, T),
+    mut merge: impl FnMut(T, T) -> T,
+) -> usize {
+    let mut lowest = stack.len();
+    match stack.last_mut() {
+        Some(top) if siblings(&top.0, &block.0) => {
+            top.0.end = block.0.end;
+            top.1 = merge(top.1, block.1);
+            lowest = stack.len() - 1;
+        }
+        _ => stack.push(block),
+    }
+    while stack.len() >= 2 && siblings(&stack[stack.len() - 2].0, &stack[stack.len() - 1].0) {
+        let (range, later) = stack.pop().expect("two blocks");
+        let below = stack.last_mut().expect("two blocks");
+        below.0.end = range.end;
+        below.1 = merge(below.1, later);
+        lowest = lowest.min(stack.len() - 1);
+    }
+    lowest
+}
+
+impl PassPlan {
+    /// The statistics of one pixel after the pass: `old(j)` is its value in
+    /// the film's block `j` (for `j >= keep`), `pass[m]` its value over the
+    /// pass's block `m`; `write(j, v)` receives the new value of block `j`
+    /// for every `j >= keep`.
+    #[inline]
+    pub(crate) fn apply(
+        &self,
+        old: impl Fn(usize) -> PixelStats,
+        pass: &[PixelStats],
+        mut write: impl FnMut(usize, PixelStats),
+    ) {
+        let mut stack: SmallVec<[(Range<u32>, PixelStats); 8]> = (self.keep..self.before.len())
+            .map(|j| (self.before[j].clone(), old(j)))
+            .collect();
+        for (range, stats) in self.pass.iter().zip(pass) {
+            join(&mut stack, (range.clone(), *stats), PixelStats::merged);
+        }
+        if self.seal {
+            // The fold `Film::pixel_at` would do on the blocks: the same
+            // merges in the same order.
+            write(
+                0,
+                stack
+                    .into_iter()
+                    .fold(PixelStats::default(), |acc, (_, b)| acc.merged(b)),
+            );
+            return;
+        }
+        debug_assert_eq!(stack.len() + self.keep, self.after.len());
+        for (k, (_, stats)) in stack.into_iter().enumerate() {
+            write(self.keep + k, stats);
+        }
+    }
+
+    /// The pass's blocks, in order.
+    pub(crate) fn pass_blocks(&self) -> &[Range<u32>] {
+        &self.pass
+    }
+}
+
+/// Where the tiles of a pass merge their pixels into the film, each under
+/// the lock of its band of rows (a tile's pixels are not contiguous in a
+/// row-major image; a band of `tile` rows is). A tile's commit takes
+/// microseconds against its milliseconds of rendering, so the locks are
+/// not contended.
+pub(crate) struct PassSink<'a> {
+    plan: &'a PassPlan,
+    width: u32,
+    tile: u32,
+    /// Per band of rows, per block from `plan.keep` on, the band's pixels.
+    bands: Vec<Mutex<Vec<&'a mut [PixelStats]>>>,
+}
+
+impl PassSink<'_> {
+    /// Merges a finished tile in: `blocks[m]` holds the tile's pixels
+    /// (row-major, `size` wide) over the pass's block `m`.
+    pub(crate) fn commit(&self, origin: UVec2, size: UVec2, blocks: &[Vec<PixelStats>]) {
+        let band = origin.y / self.tile;
+        let mut images = self.bands[band as usize]
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        let mut pass: SmallVec<[PixelStats; 8]> = SmallVec::new();
+        for ty in 0..size.y {
+            for tx in 0..size.x {
+                let in_tile = (ty * size.x + tx) as usize;
+                let i = ((origin.y % self.tile + ty) * self.width + origin.x + tx) as usize;
+                pass.clear();
+                pass.extend(blocks.iter().map(|b| b[in_tile]));
+                let keep = self.plan.keep;
+                let old: SmallVec<[PixelStats; 8]> = images.iter().map(|img| img[i]).collect();
+                self.plan
+                    .apply(|j| old[j - keep], &pass, |j, v| images[j - keep][i] = v);
+            }
+        }
+    }
 }
 
 impl Film {
@@ -231,30 +395,86 @@ impl Film {
             width,
             height,
             start,
-            blocks: Vec::new(),
+            ranges: Vec::new(),
+            images: Vec::new(),
+            unfinished: None,
+            seal_at: None,
+            sealed: false,
         }
     }
 
     /// The sample indices every pixel has seen (less any NaN or infinite
-    /// sample, dropped and counted by the render): a film is always a whole
-    /// number of samples per pixel, however its render was cut.
+    /// sample, dropped and counted by the render): a film is a whole number
+    /// of samples per pixel however its render was cut, except for the
+    /// tiles that finished an interrupted pass (see
+    /// [`Film::unfinished_pass`]), which hold more.
     pub fn samples(&self) -> Range<u32> {
-        let end = self.blocks.last().map_or(self.start, |b| b.samples.end);
+        let end = self.ranges.last().map_or(self.start, |b| b.end);
         self.start..end
     }
 
-    /// Samples per pixel rendered so far.
+    /// Samples per pixel that every pixel has.
     pub fn spp(&self) -> u32 {
         let r = self.samples();
         r.end - r.start
     }
 
+    /// The interrupted pass's sample indices and the share of pixels that
+    /// have them, if the last pass was cancelled after some of its tiles.
+    pub fn unfinished_pass(&self) -> Option<(Range<u32>, f64)> {
+        let u = self.unfinished.as_ref()?;
+        let (w, h) = (self.width, self.height);
+        let tiles_x = w.div_ceil(u.tile);
+        let done: u64 = (0..u.done.len() as u32)
+            .filter(|&t| u.done[t as usize])
+            .map(|t| {
+                let (x, y) = ((t % tiles_x) * u.tile, (t / tiles_x) * u.tile);
+                u64::from((w - x).min(u.tile)) * u64::from((h - y).min(u.tile))
+            })
+            .sum();
+        Some((
+            u.samples.clone(),
+            done as f64 / (f64::from(w) * f64::from(h)),
+        ))
+    }
+
     /// Each dyadic block of samples with every pixel's statistics over it,
-    /// in order: the film's full state, what a checkpoint saves.
-    pub fn blocks(&self) -> impl Iterator<Item = (Range<u32>, &[PixelStats])> {
-        self.blocks
+    /// in order: the film's full state, what a checkpoint saves. Refused
+    /// for a film whose last pass was interrupted.
+    pub fn blocks(&self) -> Result<impl Iterator<Item = (Range<u32>, &[PixelStats])>, FilmError> {
+        self.check_whole()?;
+        Ok(self
+            .ranges
             .iter()
-            .map(|b| (b.samples.clone(), b.pixels.as_slice()))
+            .zip(&self.images)
+            .map(|(r, img)| (r.clone(), img.as_slice())))
+    }
+
+    fn check_whole(&self) -> Result<(), FilmError> {
+        match &self.unfinished {
+            Some(u) => Err(FilmError::UnfinishedPass(u.samples.clone())),
+            None if self.sealed => Err(FilmError::Sealed(self.samples())),
+            None => Ok(()),
+        }
+    }
+
+    /// Declares that the film will only be looked at once it reaches sample
+    /// index `end`, never saved or extended: the pass that reaches `end`
+    /// merges the film's blocks into one image as its tiles commit. The
+    /// image is bit-identical to the unsealed film's (both merge the same
+    /// blocks in the same order), and it takes one image's memory whatever
+    /// `end`, where a film of `0..24` otherwise holds two (`0..16` and
+    /// `16..24`) for exact resumes and merges. A render without a
+    /// checkpoint wants this.
+    pub fn sealed_at(mut self, end: u32) -> Film {
+        self.seal_at = Some(end);
+        self
+    }
+
+    /// Whether the film has merged its blocks into one image (see
+    /// [`Film::sealed_at`]).
+    pub fn is_sealed(&self) -> bool {
+        self.sealed
     }
 
     /// A film from saved blocks (a checkpoint or a shard): each block's
@@ -278,12 +498,8 @@ impl Film {
 
     /// Appends the statistics of the samples that follow the film's (each
     /// pixel's, row-major), merging dyadic siblings as a binary counter
-    /// carries.
-    pub(crate) fn append(
-        &mut self,
-        samples: Range<u32>,
-        pixels: Vec<PixelStats>,
-    ) -> Result<(), FilmError> {
+    /// carries (the whole-image form of [`PassPlan::apply`]).
+    fn append(&mut self, samples: Range<u32>, pixels: Vec<PixelStats>) -> Result<(), FilmError> {
         let count = self.width as usize * self.height as usize;
         if pixels.len() != count {
             return Err(FilmError::PixelCount(pixels.len(), count));
@@ -296,66 +512,130 @@ impl Film {
             return Err(FilmError::InvalidStats(samples));
         }
         self.check_follows(&samples)?;
-        if self.top_is_sibling_of(&samples) {
-            self.merge_into_top(samples, |i| pixels[i]);
-        } else {
-            self.blocks.push(Block { samples, pixels });
+        let mut stack: SmallVec<[(Range<u32>, usize); 8]> =
+            self.ranges.iter().cloned().zip(0..).collect();
+        // Images are moved, not copied: the merges go into the earlier
+        // image, as `PixelStats::merged` wants the earlier samples first.
+        let mut incoming = Some(pixels);
+        let images = &mut self.images;
+        join(&mut stack, (samples, usize::MAX), |earlier, later| {
+            let later_pixels = if later == usize::MAX {
+                incoming.take().expect("merged once")
+            } else {
+                images.pop().expect("the later image is the last")
+            };
+            for (a, p) in images[earlier].iter_mut().zip(&later_pixels) {
+                *a = a.merged(*p);
+            }
+            earlier
+        });
+        if let Some(pixels) = incoming {
+            images.push(pixels);
         }
-        self.carry();
-        Ok(())
-    }
-
-    /// [`Film::append`] for a render pass, whose pixels come out of its
-    /// tiles: `pixel(i)` is pixel `i`'s statistics over `samples`. Merges in
-    /// place when it can, so the film does not briefly exist twice.
-    pub(crate) fn append_with(
-        &mut self,
-        samples: Range<u32>,
-        pixel: impl Fn(usize) -> PixelStats,
-    ) -> Result<(), FilmError> {
-        self.check_follows(&samples)?;
-        if self.top_is_sibling_of(&samples) {
-            self.merge_into_top(samples, pixel);
-        } else {
-            let count = self.width as usize * self.height as usize;
-            let pixels = (0..count).map(pixel).collect();
-            self.blocks.push(Block { samples, pixels });
-        }
-        self.carry();
+        self.ranges = stack.into_iter().map(|(r, _)| r).collect();
+        debug_assert_eq!(self.ranges.len(), self.images.len());
         Ok(())
     }
 
     fn check_follows(&self, samples: &Range<u32>) -> Result<(), FilmError> {
+        self.check_whole()?;
         if samples.start != self.samples().end || samples.end <= samples.start {
             return Err(FilmError::NotContiguous(self.samples(), samples.clone()));
         }
         Ok(())
     }
 
-    fn top_is_sibling_of(&self, samples: &Range<u32>) -> bool {
-        self.blocks
-            .last()
-            .is_some_and(|top| siblings(&top.samples, samples))
-    }
-
-    fn merge_into_top(&mut self, samples: Range<u32>, pixel: impl Fn(usize) -> PixelStats) {
-        let top = self.blocks.last_mut().expect("checked by the caller");
-        for (i, a) in top.pixels.iter_mut().enumerate() {
-            *a = a.merged(pixel(i));
+    /// Prepares a render pass over `samples`: the plan of its merges, and
+    /// the images of the blocks it adds (empty until its tiles commit).
+    pub(crate) fn begin_pass(&mut self, samples: Range<u32>) -> Result<PassPlan, FilmError> {
+        self.check_follows(&samples)?;
+        let pass = dyadic_blocks(samples.clone());
+        let mut stack: SmallVec<[(Range<u32>, ()); 8]> =
+            self.ranges.iter().map(|r| (r.clone(), ())).collect();
+        let mut keep = self.ranges.len();
+        for b in &pass {
+            keep = keep.min(join(&mut stack, (b.clone(), ()), |_, _| ()));
         }
-        top.samples.end = samples.end;
+        let mut after: Vec<Range<u32>> = stack.into_iter().map(|(r, _)| r).collect();
+        let seal = self.seal_at == Some(samples.end) && after.len() > 1;
+        if seal {
+            after = std::iter::once(self.start..samples.end).collect();
+            keep = 0;
+        }
+        let count = self.width as usize * self.height as usize;
+        while self.images.len() < after.len() {
+            self.images.push(vec![PixelStats::default(); count]);
+        }
+        Ok(PassPlan {
+            samples,
+            pass,
+            keep,
+            seal,
+            before: self.ranges.clone(),
+            after,
+        })
     }
 
-    /// Merges the top block into the one below while they are siblings.
-    fn carry(&mut self) {
-        while self.blocks.len() >= 2 {
-            let n = self.blocks.len();
-            if !siblings(&self.blocks[n - 2].samples, &self.blocks[n - 1].samples) {
-                break;
+    /// Where the tiles of the pass `plan` (of `tile`-sized tiles) commit.
+    pub(crate) fn pass_sink<'a>(&'a mut self, plan: &'a PassPlan, tile: u32) -> PassSink<'a> {
+        let band_len = (self.width * tile) as usize;
+        let bands_count = self.height.div_ceil(tile) as usize;
+        let mut bands: Vec<Vec<&mut [PixelStats]>> = (0..bands_count).map(|_| Vec::new()).collect();
+        for image in self.images[plan.keep..].iter_mut() {
+            for (band, pixels) in bands.iter_mut().zip(image.chunks_mut(band_len)) {
+                band.push(pixels);
             }
-            let top = self.blocks.pop().expect("two blocks");
-            self.merge_into_top(top.samples, |i| top.pixels[i]);
         }
+        PassSink {
+            plan,
+            width: self.width,
+            tile,
+            bands: bands.into_iter().map(Mutex::new).collect(),
+        }
+    }
+
+    /// Ends the pass `plan`: `done[t]` says whether tile `t` (row-major)
+    /// committed. When all did, the film is whole again; when none did, it
+    /// is as before the pass; otherwise it is unfinished.
+    pub(crate) fn end_pass(&mut self, plan: PassPlan, tile: u32, done: Vec<bool>) {
+        if done.iter().all(|&d| d) {
+            self.images.truncate(plan.after.len());
+            self.ranges = plan.after;
+            self.sealed = plan.seal;
+        } else if !done.iter().any(|&d| d) {
+            self.images.truncate(plan.before.len());
+        } else {
+            self.unfinished = Some(UnfinishedPass {
+                samples: plan.samples,
+                after: plan.after,
+                tile,
+                done,
+            });
+        }
+    }
+
+    /// The blocks that pixel `i` holds.
+    fn ranges_of(&self, i: usize) -> &[Range<u32>] {
+        match &self.unfinished {
+            None => &self.ranges,
+            Some(u) => {
+                let (x, y) = (i as u32 % self.width, i as u32 / self.width);
+                let t = (y / u.tile) * self.width.div_ceil(u.tile) + x / u.tile;
+                if u.done[t as usize] {
+                    &u.after
+                } else {
+                    &self.ranges
+                }
+            }
+        }
+    }
+
+    /// Pixel `i`'s statistics over all its samples: its blocks merged in
+    /// order.
+    fn pixel_at(&self, i: usize) -> PixelStats {
+        (0..self.ranges_of(i).len()).fold(PixelStats::default(), |acc, j| {
+            acc.merged(self.images[j][i])
+        })
     }
 
     /// Merges films of consecutive sample ranges (shards of one render, in
@@ -365,7 +645,9 @@ impl Film {
         shards.sort_by_key(|f| f.start);
         let mut shards = shards.into_iter();
         let mut film = shards.next().ok_or(FilmError::Empty)?;
+        film.check_whole()?;
         for shard in shards {
+            shard.check_whole()?;
             if (shard.width, shard.height) != (film.width, film.height) {
                 return Err(FilmError::SizeMismatch(
                     film.width,
@@ -377,8 +659,8 @@ impl Film {
             if shard.start != film.samples().end {
                 return Err(FilmError::NotContiguous(film.samples(), shard.samples()));
             }
-            for block in shard.blocks {
-                film.append(block.samples, block.pixels)?;
+            for (samples, pixels) in shard.ranges.into_iter().zip(shard.images) {
+                film.append(samples, pixels)?;
             }
         }
         Ok(film)
@@ -392,10 +674,9 @@ impl Film {
         if self.spp() < 2 || !(mean > 0.0) {
             return f64::INFINITY;
         }
-        let pixels = self.pixels();
-        let n = 3.0 * pixels.len() as f64;
-        let var: f64 = pixels
-            .iter()
+        let n = 3.0 * self.pixels().len() as f64;
+        let var: f64 = self
+            .pixels()
             .map(|p| p.variance_of_mean().element_sum() as f64)
             .sum::<f64>()
             / n;
@@ -412,44 +693,26 @@ impl Film {
         self.height
     }
 
-    /// Statistics of pixel (x, y) over all the film's samples.
+    /// Statistics of pixel (x, y) over all its samples.
     pub fn pixel(&self, x: u32, y: u32) -> PixelStats {
-        let i = (y * self.width + x) as usize;
-        self.blocks
-            .iter()
-            .fold(PixelStats::default(), |acc, b| acc.merged(b.pixels[i]))
+        self.pixel_at((y * self.width + x) as usize)
     }
 
-    /// Statistics of every pixel over all the film's samples, row-major:
-    /// the blocks merged in order (borrowed when there is one block, as
-    /// after a render of `0..2^k`).
-    pub fn pixels(&self) -> Cow<'_, [PixelStats]> {
-        match self.blocks.as_slice() {
-            [] => Cow::Owned(vec![
-                PixelStats::default();
-                self.width as usize * self.height as usize
-            ]),
-            [one] => Cow::Borrowed(&one.pixels),
-            [first, rest @ ..] => {
-                let mut acc = first.pixels.clone();
-                for b in rest {
-                    for (a, p) in acc.iter_mut().zip(&b.pixels) {
-                        *a = a.merged(*p);
-                    }
-                }
-                Cow::Owned(acc)
-            }
-        }
+    /// Statistics of every pixel over all its samples, row-major, computed
+    /// as they are read (its blocks merged in order): looking at a film
+    /// never copies it.
+    pub fn pixels(&self) -> impl ExactSizeIterator<Item = PixelStats> + '_ {
+        (0..self.width as usize * self.height as usize).map(|i| self.pixel_at(i))
     }
 
     /// Mean radiance of every pixel, row-major.
     pub fn mean_image(&self) -> Vec<Vec3> {
-        self.pixels().iter().map(|p| p.mean).collect()
+        self.pixels().map(|p| p.mean).collect()
     }
 
     /// Variance of the mean of every pixel, row-major.
     pub fn variance_image(&self) -> Vec<Vec3> {
-        self.pixels().iter().map(|p| p.variance_of_mean()).collect()
+        self.pixels().map(|p| p.variance_of_mean()).collect()
     }
 
     /// The mean image as 8-bit sRGB (IEC 61966-2-1), clamped, after scaling
@@ -466,7 +729,6 @@ impl Film {
             (v * 255.0 + 0.5) as u8
         };
         self.pixels()
-            .iter()
             .flat_map(|p| [encode(p.mean.x), encode(p.mean.y), encode(p.mean.z)])
             .collect()
     }
@@ -474,26 +736,24 @@ impl Film {
     /// Mean over pixels and channels of the per-sample variance: the noise
     /// of one sample, the figure the strategies are compared on.
     pub fn mean_sample_variance(&self) -> f64 {
-        let pixels = self.pixels();
-        let sum: f64 = pixels
-            .iter()
+        let sum: f64 = self
+            .pixels()
             .map(|p| p.sample_variance().element_sum() as f64)
             .sum();
-        sum / (3.0 * pixels.len() as f64)
+        sum / (3.0 * self.pixels().len() as f64)
     }
 
     /// Mean of the image over pixels and channels, with its standard error
     /// (pixels are independent, so the variances of their means add).
     pub fn image_mean(&self) -> (f64, f64) {
-        let pixels = self.pixels();
-        let n = 3.0 * pixels.len() as f64;
-        let mean: f64 = pixels
-            .iter()
+        let n = 3.0 * self.pixels().len() as f64;
+        let mean: f64 = self
+            .pixels()
             .map(|p| p.mean.element_sum() as f64)
             .sum::<f64>()
             / n;
-        let var: f64 = pixels
-            .iter()
+        let var: f64 = self
+            .pixels()
             .map(|p| p.variance_of_mean().element_sum() as f64)
             .sum::<f64>()
             / (n * n);
@@ -602,7 +862,7 @@ mod tests {
     fn any_cut_gives_the_same_bits() {
         let value = |i: u32| (i as f32 * 0.618_034).fract() * 10.0 + 1e3;
         let whole = film_of(0..100, value);
-        assert_eq!(whole.blocks().count(), 3);
+        assert_eq!(whole.blocks().unwrap().count(), 3);
         for cut in [1, 37, 64, 65, 99] {
             let parts = vec![film_of(cut..100, value), film_of(0..cut, value)];
             let merged = Film::merge(parts).unwrap();

@@ -8,7 +8,7 @@ use glam::UVec2;
 use lueur_sampling::{Sampler, SamplerKind};
 use rayon::prelude::*;
 
-use crate::film::{BlockCounter, Film, PixelStats, dyadic_blocks};
+use crate::film::{BlockCounter, Film, PixelStats};
 use crate::path::{CAMERA_DIMS, Estimator, March, RayCounters, SampleId, radiance};
 use crate::{RenderError, Scene, Strategy};
 
@@ -133,9 +133,8 @@ pub struct RenderStats {
     pub samples: u64,
     /// Wall-clock time of the render.
     pub elapsed: Duration,
-    /// Wall-clock time spent merging passes into the film (after the
-    /// tiles, on one thread): the part of a pass that does not run in
-    /// parallel.
+    /// Time the threads spent merging finished tiles into the film (summed
+    /// over threads, like the tracing time).
     pub film_time: Duration,
     /// Threads the render ran on (of the rayon pool in force).
     pub threads: usize,
@@ -177,16 +176,28 @@ pub fn render(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<RenderOutput, RenderError> {
     let mut film = Film::new(settings.width, settings.height);
-    let stats = render_pass(
+    let pass = render_pass(
         scene,
         settings,
         &mut film,
         settings.spp,
         &AtomicBool::new(false),
         progress,
-    )?
-    .expect("a render that cannot be cancelled completes");
-    Ok(RenderOutput { film, stats })
+    )?;
+    debug_assert!(pass.complete, "a render that cannot be cancelled completes");
+    Ok(RenderOutput {
+        film,
+        stats: pass.stats,
+    })
+}
+
+/// What one pass did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pass {
+    /// What it cost and measured (of the tiles it finished).
+    pub stats: RenderStats,
+    /// Whether every tile finished: false when it was cancelled.
+    pub complete: bool,
 }
 
 /// Adds sample indices `film.samples().end..until` to every pixel of
@@ -199,9 +210,12 @@ pub fn render(
 /// `settings.spp` is the spp of the whole render: some samplers lay their
 /// patterns out over it, so shards must share it; `until` may not pass it.
 ///
-/// `cancel` is polled before every pixel; once it is set the pass is
-/// abandoned, `film` is left exactly as it was (still a whole number of
-/// samples per pixel) and `Ok(None)` is returned.
+/// Each tile is merged into the film as soon as it finishes, so the film
+/// never exists twice. `cancel` is polled before every pixel; once it is
+/// set, no tile starts or finishes, and the pass returns with `complete`
+/// false: the film keeps the tiles finished before the signal (it is then
+/// [unfinished](Film::unfinished_pass) and can be written out but not
+/// extended), or is left exactly as it was if there were none.
 pub fn render_pass(
     scene: &Scene,
     settings: &RenderSettings,
@@ -209,12 +223,17 @@ pub fn render_pass(
     until: u32,
     cancel: &AtomicBool,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<Option<RenderStats>, RenderError> {
+) -> Result<Pass, RenderError> {
     settings.validate()?;
     let (w, h) = (settings.width, settings.height);
     if film.width() != w || film.height() != h {
         return Err(RenderError::InvalidSetting(
             "the film's size differs from the settings'",
+        ));
+    }
+    if film.unfinished_pass().is_some() {
+        return Err(RenderError::InvalidSetting(
+            "the film's last pass was interrupted: it cannot be extended",
         ));
     }
     let from = film.samples().end;
@@ -234,45 +253,48 @@ pub fn render_pass(
         .flat_map(|ty| (0..tiles_x).map(move |tx| UVec2::new(tx * TILE, ty * TILE)))
         .collect();
 
-    let results: Vec<Option<TileResult>> = tiles
+    let plan = film
+        .begin_pass(from..until)
+        .expect("checked: the pass follows a whole film");
+    let sink = film.pass_sink(&plan, TILE);
+    let results: Vec<Option<TileCost>> = tiles
         .par_iter()
         .map(|&origin| {
-            let r = render_tile(&estimator, origin, from..until, cancel)?;
+            let r = render_tile(&estimator, origin, plan.pass_blocks(), cancel)?;
+            // Checked again so that no tile commits after the signal has
+            // been seen: what an interrupt writes is what was there then.
+            if cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            let film_start = Instant::now();
+            sink.commit(origin, UVec2::new(r.width, r.height), &r.blocks);
+            let film_time = film_start.elapsed();
             progress(u64::from(r.width * r.height) * u64::from(until - from));
-            Some(r)
+            // The tile's statistics are in the film now; keeping them until
+            // the pass ends would hold the pass twice.
+            Some(TileCost {
+                samples: r.blocks.iter().flatten().map(|p| u64::from(p.n)).sum(),
+                counters: r.counters,
+                dropped: r.dropped,
+                film_time,
+            })
         })
         .collect();
-    if cancel.load(Ordering::Relaxed) || results.iter().any(Option::is_none) {
-        return Ok(None);
-    }
-    let results: Vec<TileResult> = results.into_iter().flatten().collect();
+    drop(sink);
 
     let mut stats = RenderStats::default();
-    for r in &results {
+    for r in results.iter().flatten() {
         stats.rays.merge(&r.counters);
         stats.dropped_samples += r.dropped;
-        stats.samples += r
-            .blocks
-            .iter()
-            .flatten()
-            .map(|p| u64::from(p.n))
-            .sum::<u64>();
+        stats.samples += r.samples;
+        stats.film_time += r.film_time;
     }
-    let film_start = Instant::now();
-    for (j, samples) in dyadic_blocks(from..until).into_iter().enumerate() {
-        // Results are in tile order, each tile row-major.
-        let pixel = |i: usize| {
-            let (x, y) = (i as u32 % w, i as u32 / w);
-            let r = &results[((y / TILE) * tiles_x + x / TILE) as usize];
-            r.blocks[j][((y % TILE) * r.width + x % TILE) as usize]
-        };
-        film.append_with(samples, pixel)
-            .expect("a pass's blocks follow the film's");
-    }
-    stats.film_time = film_start.elapsed();
+    let done: Vec<bool> = results.iter().map(Option::is_some).collect();
+    let complete = done.iter().all(|&d| d);
+    film.end_pass(plan, TILE, done);
     stats.threads = rayon::current_num_threads();
     stats.elapsed = start.elapsed();
-    Ok(Some(stats))
+    Ok(Pass { stats, complete })
 }
 
 /// One tile's statistics after a pass, and what the pass cost there.
@@ -286,20 +308,30 @@ struct TileResult {
     dropped: u64,
 }
 
+/// What a finished tile cost, once its statistics are in the film.
+struct TileCost {
+    samples: u64,
+    counters: RayCounters,
+    dropped: u64,
+    /// Time spent merging the tile into the film.
+    film_time: Duration,
+}
+
 /// `None` when cancelled.
 fn render_tile(
     estimator: &Estimator<'_>,
     origin: UVec2,
-    samples: Range<u32>,
+    pass_blocks: &[Range<u32>],
     cancel: &AtomicBool,
 ) -> Option<TileResult> {
+    let samples = pass_blocks[0].start..pass_blocks[pass_blocks.len() - 1].end;
     let settings = estimator.settings;
     let (w, h) = (settings.width, settings.height);
     let (tw, th) = ((w - origin.x).min(TILE), (h - origin.y).min(TILE));
     let mut sampler = Sampler::for_image(settings.sampler, settings.seed, [w, h], settings.spp);
     let mut counters = RayCounters::default();
     let mut dropped = 0u64;
-    let block_count = dyadic_blocks(samples.clone()).len();
+    let block_count = pass_blocks.len();
     let mut blocks = vec![Vec::with_capacity((tw * th) as usize); block_count];
     let mut counter = BlockCounter::new();
     for y in origin.y..origin.y + th {

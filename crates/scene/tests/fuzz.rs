@@ -428,7 +428,7 @@ fn check(text: &str) -> Result<(), SceneFileError> {
                 "NaN or infinite samples ({:?})",
                 out.stats
             );
-            for p in out.film.pixels().iter() {
+            for p in out.film.pixels() {
                 assert!(p.mean.is_finite() && p.m2.is_finite(), "pixel {p:?}");
                 assert!(p.mean.min_element() >= 0.0, "negative radiance {p:?}");
             }
