@@ -52,8 +52,34 @@ pub fn settings_fingerprint(s: &RenderSettings, naive: bool) -> String {
     )
 }
 
+/// One pixel as a checkpoint stores it, channels in the file's
+/// (alphabetical) order.
+type StoredPixel = (f32, f32, f32, f32, f32, f32, u32);
+
+fn stored(p: &PixelStats) -> StoredPixel {
+    (p.m2.z, p.m2.y, p.m2.x, p.mean.z, p.mean.y, p.mean.x, p.n)
+}
+
+fn from_stored((m2b, m2g, m2r, mb, mg, mr, n): StoredPixel) -> PixelStats {
+    PixelStats {
+        n,
+        mean: glam::Vec3::new(mr, mg, mb),
+        m2: glam::Vec3::new(m2r, m2g, m2b),
+    }
+}
+
+/// A block's pixels as the EXR writer asks for them (one closure type for
+/// every layer).
+fn block_pixels(
+    px: &[PixelStats],
+    width: usize,
+) -> impl Fn(Vec2<usize>) -> StoredPixel + Sync + '_ {
+    move |pos| stored(&px[pos.y() * width + pos.x()])
+}
+
 /// Writes `film` to `path` as a checkpoint, atomically (temporary file,
-/// then rename).
+/// then rename). Pixels go from the film to the encoder as it asks for
+/// them: saving a 4K film does not copy it.
 pub fn save(path: &Path, film: &Film, scene_text: &str, fingerprint: &str) -> Result<()> {
     if film.spp() == 0 {
         bail!("an empty film has nothing to save");
@@ -61,18 +87,15 @@ pub fn save(path: &Path, film: &Film, scene_text: &str, fingerprint: &str) -> Re
     let size = (film.width() as usize, film.height() as usize);
     let mut layers = Vec::new();
     for (samples, px) in film.blocks()? {
-        let f32_channel = |name: &str, f: &dyn Fn(&PixelStats) -> f32| {
-            AnyChannel::new(name, FlatSamples::F32(px.iter().map(f).collect()))
-        };
-        let channels = AnyChannels::sort(SmallVec::from_vec(vec![
-            AnyChannel::new("n", FlatSamples::U32(px.iter().map(|p| p.n).collect())),
-            f32_channel("mean.R", &|p| p.mean.x),
-            f32_channel("mean.G", &|p| p.mean.y),
-            f32_channel("mean.B", &|p| p.mean.z),
-            f32_channel("m2.R", &|p| p.m2.x),
-            f32_channel("m2.G", &|p| p.m2.y),
-            f32_channel("m2.B", &|p| p.m2.z),
-        ]));
+        let channels = SpecificChannels::build()
+            .with_channel("m2.B")
+            .with_channel("m2.G")
+            .with_channel("m2.R")
+            .with_channel("mean.B")
+            .with_channel("mean.G")
+            .with_channel("mean.R")
+            .with_channel("n")
+            .with_pixel_fn(block_pixels(px, size.0));
         let name = format!("{LAYER_PREFIX}{}-{}", samples.start, samples.end);
         let mut attributes = LayerAttributes::named(name.as_str());
         let index = |v: u32| i32::try_from(v).context("sample index too large for a checkpoint");
@@ -138,35 +161,31 @@ pub fn load(path: &Path, scene_text: &str, fingerprint: &str) -> Result<Film> {
     Ok(saved.film)
 }
 
-/// Reads a checkpoint or shard.
+/// Reads a checkpoint or shard. The headers are checked first (is it a
+/// checkpoint, of one scene and settings, of one size?), then the pixels
+/// are decoded straight into the film's blocks.
 pub fn read_film(path: &Path) -> Result<Saved> {
     let name = path.display();
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .all_layers()
-        .all_attributes()
-        .from_file(path)
-        .with_context(|| format!("cannot read checkpoint {name}"))?;
-    let mut blocks = Vec::new();
+    let cannot_read = || format!("cannot read checkpoint {name}");
+    let meta = exr::meta::MetaData::read_from_file(path, false).with_context(cannot_read)?;
     let mut about: Option<(String, String)> = None;
     let mut size = None;
-    for layer in &image.layer_data {
+    let mut ranges = Vec::new();
+    for header in &meta.headers {
+        let layer = &header.own_attributes;
         let is_block = layer
-            .attributes
             .layer_name
             .as_ref()
             .is_some_and(|n| n.to_string().starts_with(LAYER_PREFIX));
         if !is_block {
-            continue;
+            bail!("{name} is not a lueur checkpoint (a layer is not a `{LAYER_PREFIX}*` layer)");
         }
-        let attr = |key: &str| layer.attributes.other.get(&Text::from(key));
+        let attr = |key: &str| layer.other.get(&Text::from(key));
         let index = |key: &str| match attr(key) {
             Some(AttributeValue::I32(v)) if *v >= 0 => Ok(*v as u32),
             _ => bail!("{name}: missing or bad `{key}`"),
         };
-        let samples = index(ATTR_START)?..index(ATTR_END)?;
+        ranges.push(index(ATTR_START)?..index(ATTR_END)?);
         let read_text = |key: &str| match attr(key) {
             Some(AttributeValue::Text(t)) => Ok(t.to_string()),
             _ => bail!("{name}: missing `{key}`"),
@@ -176,44 +195,44 @@ pub fn read_film(path: &Path) -> Result<Saved> {
             bail!("{name}: its layers disagree on the scene or settings");
         }
         about = Some(this);
-        let layer_size = (layer.size.0 as u32, layer.size.1 as u32);
+        let layer_size = (header.layer_size.0 as u32, header.layer_size.1 as u32);
         if size.is_some_and(|s| s != layer_size) {
             bail!("{name}: its layers differ in size");
         }
         size = Some(layer_size);
-        let channel = |n: &str| {
-            layer
-                .channel_data
-                .list
-                .iter()
-                .find(|c| c.name.to_string() == n)
-                .map(|c| &c.sample_data)
-        };
-        let f32s = |n: &str| -> Result<&Vec<f32>> {
-            match channel(n) {
-                Some(FlatSamples::F32(v)) => Ok(v),
-                _ => bail!("{name}: missing f32 channel `{n}`"),
-            }
-        };
-        let counts = match channel("n") {
-            Some(FlatSamples::U32(v)) => v,
-            _ => bail!("{name}: missing u32 channel `n`"),
-        };
-        let (mr, mg, mb) = (f32s("mean.R")?, f32s("mean.G")?, f32s("mean.B")?);
-        let (sr, sg, sb) = (f32s("m2.R")?, f32s("m2.G")?, f32s("m2.B")?);
-        let pixels = (0..counts.len())
-            .map(|i| PixelStats {
-                n: counts[i],
-                mean: glam::Vec3::new(mr[i], mg[i], mb[i]),
-                m2: glam::Vec3::new(sr[i], sg[i], sb[i]),
-            })
-            .collect();
-        blocks.push((samples, pixels));
     }
     let (Some((scene_text, fingerprint)), Some((w, h))) = (about, size) else {
         bail!("{name} is not a lueur checkpoint (no `{LAYER_PREFIX}*` layer)");
     };
-    blocks.sort_by_key(|b: &(std::ops::Range<u32>, Vec<PixelStats>)| b.0.start);
+
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .specific_channels()
+        .required::<f32>("m2.B")
+        .required::<f32>("m2.G")
+        .required::<f32>("m2.R")
+        .required::<f32>("mean.B")
+        .required::<f32>("mean.G")
+        .required::<f32>("mean.R")
+        .required::<u32>("n")
+        .collect_pixels(
+            |size: Vec2<usize>, _| (size.0, vec![PixelStats::default(); size.area()]),
+            |(width, pixels): &mut (usize, Vec<PixelStats>), pos: Vec2<usize>, p: StoredPixel| {
+                pixels[pos.y() * *width + pos.x()] = from_stored(p);
+            },
+        )
+        .all_layers()
+        .all_attributes()
+        .from_file(path)
+        .with_context(cannot_read)?;
+    // Layers come back in the file's order, the headers'.
+    let mut blocks: Vec<_> = ranges
+        .into_iter()
+        .zip(image.layer_data)
+        .map(|(samples, layer)| (samples, layer.channel_data.pixels.1))
+        .collect();
+    blocks.sort_by_key(|b| b.0.start);
     let start = blocks[0].0.start;
     let film = Film::from_blocks(w, h, start, blocks)
         .with_context(|| format!("{name}: inconsistent checkpoint data"))?;
