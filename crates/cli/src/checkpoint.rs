@@ -161,13 +161,23 @@ pub fn load(path: &Path, scene_text: &str, fingerprint: &str) -> Result<Film> {
     Ok(saved.film)
 }
 
-/// Reads a checkpoint or shard. The headers are checked first (is it a
-/// checkpoint, of one scene and settings, of one size?), then the pixels
-/// are decoded straight into the film's blocks.
-pub fn read_film(path: &Path) -> Result<Saved> {
+/// What a checkpoint's headers say, read without its pixels.
+pub struct Header {
+    /// The sample indices it holds.
+    pub samples: std::ops::Range<u32>,
+    pub scene_text: String,
+    pub fingerprint: String,
+    /// Per block, in the file's order.
+    ranges: Vec<std::ops::Range<u32>>,
+    size: (u32, u32),
+}
+
+/// Reads a checkpoint's headers: is it a checkpoint, of one scene and
+/// settings, of one size?
+pub fn read_header(path: &Path) -> Result<Header> {
     let name = path.display();
-    let cannot_read = || format!("cannot read checkpoint {name}");
-    let meta = exr::meta::MetaData::read_from_file(path, false).with_context(cannot_read)?;
+    let meta = exr::meta::MetaData::read_from_file(path, false)
+        .with_context(|| format!("cannot read checkpoint {name}"))?;
     let mut about: Option<(String, String)> = None;
     let mut size = None;
     let mut ranges = Vec::new();
@@ -201,9 +211,26 @@ pub fn read_film(path: &Path) -> Result<Saved> {
         }
         size = Some(layer_size);
     }
-    let (Some((scene_text, fingerprint)), Some((w, h))) = (about, size) else {
+    let (Some((scene_text, fingerprint)), Some(size)) = (about, size) else {
         bail!("{name} is not a lueur checkpoint (no `{LAYER_PREFIX}*` layer)");
     };
+    let start = ranges.iter().map(|r| r.start).min().unwrap_or(0);
+    let end = ranges.iter().map(|r| r.end).max().unwrap_or(0);
+    Ok(Header {
+        samples: start..end,
+        scene_text,
+        fingerprint,
+        ranges,
+        size,
+    })
+}
+
+/// Reads a checkpoint or shard: its headers first, then the pixels,
+/// decoded straight into the film's blocks.
+pub fn read_film(path: &Path) -> Result<Saved> {
+    let header = read_header(path)?;
+    let name = path.display();
+    let (w, h) = header.size;
 
     let image = read()
         .no_deep_data()
@@ -225,9 +252,10 @@ pub fn read_film(path: &Path) -> Result<Saved> {
         .all_layers()
         .all_attributes()
         .from_file(path)
-        .with_context(cannot_read)?;
+        .with_context(|| format!("cannot read checkpoint {name}"))?;
     // Layers come back in the file's order, the headers'.
-    let mut blocks: Vec<_> = ranges
+    let mut blocks: Vec<_> = header
+        .ranges
         .into_iter()
         .zip(image.layer_data)
         .map(|(samples, layer)| (samples, layer.channel_data.pixels.1))
@@ -238,7 +266,7 @@ pub fn read_film(path: &Path) -> Result<Saved> {
         .with_context(|| format!("{name}: inconsistent checkpoint data"))?;
     Ok(Saved {
         film,
-        scene_text,
-        fingerprint,
+        scene_text: header.scene_text,
+        fingerprint: header.fingerprint,
     })
 }

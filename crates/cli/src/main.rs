@@ -436,56 +436,70 @@ fn run_merge(args: MergeArgs) -> Result<()> {
     if !args.exposure.is_finite() {
         bail!(BadInput("--exposure must be finite".into()));
     }
+    // Headers first: every refusal comes before any pixel is read, and the
+    // shards are then loaded one at a time, in order, each merged into the
+    // film and dropped (8 shards of a 4K render never sit in memory at once).
     let mut shards = Vec::new();
     let mut first: Option<(PathBuf, String, String)> = None;
     for path in &args.shards {
-        let saved = checkpoint::read_film(path).map_err(|e| BadInput(format!("{e:#}")))?;
+        let header = checkpoint::read_header(path).map_err(|e| BadInput(format!("{e:#}")))?;
         match &first {
             None => {
                 first = Some((
                     path.clone(),
-                    saved.scene_text.clone(),
-                    saved.fingerprint.clone(),
+                    header.scene_text.clone(),
+                    header.fingerprint.clone(),
                 ))
             }
-            Some((p, scene, _)) if *scene != saved.scene_text => bail!(BadInput(format!(
+            Some((p, scene, _)) if *scene != header.scene_text => bail!(BadInput(format!(
                 "{} and {} are renders of different scene files; cannot merge",
                 p.display(),
                 path.display()
             ))),
-            Some((p, _, settings)) if *settings != saved.fingerprint => {
+            Some((p, _, settings)) if *settings != header.fingerprint => {
                 bail!(BadInput(format!(
                     "{} and {} were rendered with different settings; cannot merge.\n  {}: {settings}\n  {}: {}",
                     p.display(),
                     path.display(),
                     p.display(),
                     path.display(),
-                    saved.fingerprint
+                    header.fingerprint
                 )))
             }
             Some(_) => {}
         }
-        shards.push((path.clone(), saved.film));
+        shards.push((path.clone(), header.samples));
     }
     let (_, scene_text, fingerprint) = first.expect("clap requires one shard");
     // Name the files on either side of a gap or an overlap.
-    shards.sort_by_key(|(_, f)| f.samples().start);
+    shards.sort_by_key(|(_, samples)| samples.start);
     for pair in shards.windows(2) {
         let (a, b) = (&pair[0], &pair[1]);
-        if a.1.samples().end != b.1.samples().start {
+        if a.1.end != b.1.start {
             bail!(BadInput(format!(
                 "{} holds samples {:?} and {} holds {:?}: shards must follow each other \
                  without gap or overlap",
                 a.0.display(),
-                a.1.samples(),
+                a.1,
                 b.0.display(),
-                b.1.samples()
+                b.1
             )));
         }
     }
     let count = shards.len();
-    let film = Film::merge(shards.into_iter().map(|(_, f)| f).collect())
-        .map_err(|e| BadInput(format!("cannot merge: {e}")))?;
+    let mut film: Option<Film> = None;
+    for (path, _) in &shards {
+        let shard = checkpoint::read_film(path)
+            .map_err(|e| BadInput(format!("{e:#}")))?
+            .film;
+        let merged = match film.take() {
+            None => shard,
+            Some(f) => Film::merge(vec![f, shard])
+                .map_err(|e| BadInput(format!("cannot merge {}: {e}", path.display())))?,
+        };
+        film = Some(merged);
+    }
+    let film = film.expect("clap requires one shard");
     output::write_image(&args.out, format, &film, args.exposure)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
     if let Some(path) = &args.checkpoint {

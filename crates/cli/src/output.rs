@@ -2,6 +2,7 @@
 //! truncated file behind.
 
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use anyhow::{Context, Result, bail};
 use lueur_integrator::{Film, PixelStats};
@@ -41,15 +42,34 @@ pub fn write_image(path: &Path, format: Format, film: &Film, exposure: f32) -> R
     })
 }
 
+/// Temporary files being written, for [`remove_temporaries`].
+static WRITING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
 /// Runs `write` on a temporary file beside `path`, then renames it into
 /// place: readers see the old file or the whole new one, never a torn one.
 pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let tmp = temporary_path(path);
-    if let Err(e) = write(&tmp) {
+    let writing = || WRITING.lock().unwrap_or_else(|e| e.into_inner());
+    writing().push(tmp.clone());
+    let result = write(&tmp).and_then(|()| {
+        std::fs::rename(&tmp, path)
+            .with_context(|| format!("cannot move {} into place", tmp.display()))
+    });
+    if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
-        return Err(e);
     }
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot move {} into place", tmp.display()))
+    writing().retain(|p| *p != tmp);
+    result
+}
+
+/// Removes the temporary files being written: a second interrupt exits in
+/// the middle of a write, and must not leave one behind. (A rename that
+/// races with this finds no file, and the target is left as it was.)
+pub fn remove_temporaries() {
+    let writing = WRITING.lock().unwrap_or_else(|e| e.into_inner());
+    for tmp in writing.iter() {
+        let _ = std::fs::remove_file(tmp);
+    }
 }
 
 fn temporary_path(path: &Path) -> PathBuf {
@@ -92,4 +112,29 @@ fn write_exr(path: &Path, film: &Film) -> Result<()> {
     );
     Image::from_layer(layer).write().to_file(path)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What a second interrupt does in the middle of a write: the
+    /// temporary file goes, and the target is not created from it.
+    #[test]
+    fn an_exit_mid_write_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("i.png");
+        let result = write_atomically(&target, |tmp| {
+            std::fs::write(tmp, b"half an image")?;
+            remove_temporaries();
+            Ok(())
+        });
+        assert!(result.is_err(), "the rename finds no file");
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert!(left.is_empty(), "{left:?}");
+        // And a write that is not interrupted is not affected by the list.
+        write_atomically(&target, |tmp| Ok(std::fs::write(tmp, b"whole")?)).unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"whole");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
 }

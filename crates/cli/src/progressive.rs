@@ -25,6 +25,7 @@ pub fn install_signal_handler() -> anyhow::Result<()> {
     ctrlc::set_handler(|| {
         if SIGNALS.fetch_add(1, Ordering::SeqCst) >= 1 {
             eprintln!("\nsecond interrupt: exiting without writing");
+            crate::output::remove_temporaries();
             std::process::exit(i32::from(EXIT_INTERRUPTED));
         }
         CANCEL.store(true, Ordering::SeqCst);
