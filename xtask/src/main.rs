@@ -3,6 +3,7 @@
 
 mod compose;
 mod figures;
+mod memory;
 mod plot;
 mod pointset_figures;
 mod reference;
@@ -60,6 +61,21 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Measure the peak resident memory of `lueur` on 4K renders (plain,
+    /// with checkpoints, resumed, merged from shards); writes
+    /// docs/MEMORY.md and fails if a render passes 400 MB.
+    Memory {
+        /// A 480x270 image, for CI (no target applies).
+        #[arg(long)]
+        quick: bool,
+    },
+    /// Run a command and print its peak resident set in kB (used by
+    /// `memory`, one process per measurement).
+    #[command(hide = true)]
+    MemoryProbe {
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true, required = true)]
+        command: Vec<String>,
+    },
 }
 
 fn main() -> Result<()> {
@@ -68,6 +84,8 @@ fn main() -> Result<()> {
         Command::Variance { quick } => variance::run(quick),
         Command::Tradeoff { quick } => tradeoff::run(quick),
         Command::Samplers { quick, report_only } => samplers::run(quick, report_only),
+        Command::Memory { quick } => memory::run(quick),
+        Command::MemoryProbe { command } => memory::probe(&command),
     }
 }
 
