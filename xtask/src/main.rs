@@ -4,6 +4,7 @@
 mod compose;
 mod figures;
 mod memory;
+mod peers;
 mod plot;
 mod pointset_figures;
 mod reference;
@@ -69,6 +70,14 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Compare lueur with Mitsuba 3 on cornell-spheres (correctness against
+    /// a Mitsuba reference, speed and MSE x time); needs `pip install
+    /// mitsuba`; writes docs/PEERS.md.
+    Peers {
+        /// 64x64 and few samples, to check the pipeline.
+        #[arg(long)]
+        quick: bool,
+    },
     /// Run a command and print its peak resident set in kB (used by
     /// `memory`, one process per measurement).
     #[command(hide = true)]
@@ -85,6 +94,7 @@ fn main() -> Result<()> {
         Command::Tradeoff { quick } => tradeoff::run(quick),
         Command::Samplers { quick, report_only } => samplers::run(quick, report_only),
         Command::Memory { quick } => memory::run(quick),
+        Command::Peers { quick } => peers::run(quick),
         Command::MemoryProbe { command } => memory::probe(&command),
     }
 }

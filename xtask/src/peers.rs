@@ -1,0 +1,553 @@
+//! `cargo xtask peers`: lueur against Mitsuba 3 on the shipped scene both
+//! can express (`cornell-spheres.toml`: boxes, spheres, Lambertian and
+//! mirror, a sphere light), for correctness and for speed.
+//!
+//! Mitsuba is a peer for measurement only, never a dependency: this report
+//! runs `xtask/peers/mitsuba_render.py` with the machine's `python3` where
+//! `pip install mitsuba` was done (for `llvm_ad_rgb`, also Debian's
+//! `libllvm19`; `DRJIT_LIBLLVM_PATH` is set to it when found), and refuses
+//! to run otherwise. CI does not run it.
+//!
+//! 1. **Correctness**: lueur's `mis` with independent samples at the
+//!    highest spp against a Mitsuba reference (`llvm_ad_rgb`, independent,
+//!    many passes with other seeds): per-channel image means and a z-map
+//!    over 8x8-pixel regions, each z using both images' standard errors.
+//! 2. **Speed and efficiency**: every configuration at 4 to 256 spp, MSE
+//!    against the reference (less the reference's own variance) and the
+//!    render time (lueur: its own measured render; Mitsuba: the warm
+//!    render, the kernel compile of the JIT variant reported apart), so
+//!    samples per second and MSE x time (lower is better: the time needed
+//!    for a given error is proportional to it) compare in one run.
+//!    Writes `docs/PEERS.md`.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{Context, Result, bail, ensure};
+use lueur::integrator::{RenderSettings, Strategy};
+use lueur::sampling::SamplerKind;
+
+use crate::reference::{cache_dir, flatten, render_film};
+use crate::{docs_dir, load_scene, project_root};
+
+const SCENE: &str = "cornell-spheres";
+const LLVM19: &str = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1";
+
+struct Plan {
+    size: u32,
+    spps: &'static [u32],
+    /// The spp whose time is a median of `repeats` renders: the speed table.
+    timed_spp: u32,
+    repeats: u32,
+    reference_passes: u32,
+    reference_pass_spp: u32,
+}
+
+const FULL: Plan = Plan {
+    size: 256,
+    spps: &[4, 16, 64, 256],
+    timed_spp: 64,
+    repeats: 3,
+    reference_passes: 16,
+    reference_pass_spp: 256,
+};
+
+const QUICK: Plan = Plan {
+    size: 64,
+    spps: &[4, 16],
+    timed_spp: 16,
+    repeats: 1,
+    reference_passes: 4,
+    reference_pass_spp: 64,
+};
+
+#[derive(Clone, Copy)]
+enum Config {
+    Lueur(SamplerKind),
+    Mitsuba {
+        variant: &'static str,
+        sampler: &'static str,
+    },
+}
+
+impl Config {
+    fn name(&self) -> String {
+        match self {
+            Config::Lueur(s) => format!("lueur mis, {}", s.name()),
+            Config::Mitsuba { variant, sampler } => format!("Mitsuba {variant}, {sampler}"),
+        }
+    }
+}
+
+/// One render's figures.
+struct Measured {
+    spp: u32,
+    seconds: f64,
+    /// Mitsuba's JIT variants: the first render, kernel compile included.
+    first_seconds: Option<f64>,
+    mse: f64,
+}
+
+/// An RGB image, interleaved, with its size.
+struct Rgb {
+    width: usize,
+    pixels: Vec<f32>,
+}
+
+fn read_rgb(path: &Path) -> Result<Rgb> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |res, _| (res.width(), vec![0f32; 3 * res.width() * res.height()]),
+        |(w, px): &mut (usize, Vec<f32>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            let i = 3 * (pos.y() * *w + pos.x());
+            px[i..i + 3].copy_from_slice(&[r, g, b]);
+        },
+    )
+    .with_context(|| format!("reading {}", path.display()))?;
+    let (width, pixels) = image.layer_data.channel_data.pixels;
+    Ok(Rgb { width, pixels })
+}
+
+fn python() -> Command {
+    let mut c = Command::new(std::env::var("LUEUR_PYTHON").unwrap_or_else(|_| "python3".into()));
+    if std::env::var_os("DRJIT_LIBLLVM_PATH").is_none() && Path::new(LLVM19).exists() {
+        c.env("DRJIT_LIBLLVM_PATH", LLVM19);
+    }
+    c
+}
+
+fn script() -> PathBuf {
+    project_root()
+        .join("xtask")
+        .join("peers")
+        .join("mitsuba_render.py")
+}
+
+fn scene_path() -> PathBuf {
+    project_root().join("scenes").join(format!("{SCENE}.toml"))
+}
+
+/// Runs the Mitsuba script; returns its JSON line's numbers by key.
+fn mitsuba(args: &[String]) -> Result<serde_like::Json> {
+    let out = python()
+        .arg(script())
+        .arg(scene_path())
+        .args(args)
+        .output()
+        .context("cannot run python3")?;
+    if !out.status.success() {
+        bail!(
+            "mitsuba_render.py {}: {}",
+            args.join(" "),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout
+        .lines()
+        .last()
+        .context("no output from mitsuba_render.py")?;
+    Ok(serde_like::Json(line.to_owned()))
+}
+
+/// The few numbers read back from the script's one-line JSON (no JSON
+/// crate for three keys of a line we write ourselves).
+mod serde_like {
+    pub struct Json(pub String);
+    impl Json {
+        pub fn number(&self, key: &str) -> Option<f64> {
+            let at = self.0.find(&format!("\"{key}\": "))? + key.len() + 4;
+            let rest = &self.0[at..];
+            let end = rest.find([',', '}']).unwrap_or(rest.len());
+            rest[..end].trim().parse().ok()
+        }
+    }
+}
+
+pub fn run(quick: bool) -> Result<()> {
+    let plan = if quick { &QUICK } else { &FULL };
+    let check = python()
+        .args(["-c", "import mitsuba"])
+        .output()
+        .context("cannot run python3")?;
+    ensure!(
+        check.status.success(),
+        "Mitsuba 3 is not installed for python3: `pip install mitsuba` (and, for llvm_ad_rgb, \
+         Debian's libllvm19). It is a peer for this report only, never a dependency of lueur."
+    );
+    let work = cache_dir()?.join("peers");
+    std::fs::create_dir_all(&work)?;
+    // The reference: Mitsuba's fastest variant, independent samples, seeds
+    // far from the measured renders'.
+    let reference_path = work.join(format!("reference-{}px.exr", plan.size));
+    eprintln!(
+        "reference: Mitsuba llvm_ad_rgb, {} passes of {} spp",
+        plan.reference_passes, plan.reference_pass_spp
+    );
+    let mut args = vec!["llvm_ad_rgb".to_string()];
+    args.push(plan.reference_pass_spp.to_string());
+    args.push(reference_path.display().to_string());
+    args.extend([
+        "--passes".into(),
+        plan.reference_passes.to_string(),
+        "--seed".into(),
+        "100000".into(),
+        "--width".into(),
+        plan.size.to_string(),
+        "--height".into(),
+        plan.size.to_string(),
+    ]);
+    // Cached: the reference takes minutes, and is a function of the scene
+    // text, the plan and Mitsuba's version only.
+    let key = format!(
+        "{}\n{} {} {}\n{}",
+        std::fs::read_to_string(scene_path())?,
+        plan.size,
+        plan.reference_passes,
+        plan.reference_pass_spp,
+        mitsuba_version()
+    );
+    let key_path = reference_path.with_extension("key");
+    let cached = std::fs::read_to_string(&key_path).is_ok_and(|k| k == key)
+        && reference_path.with_extension("var.exr").exists();
+    let reference_time = if cached {
+        eprintln!("reference: cached in {}", reference_path.display());
+        f64::NAN
+    } else {
+        let t = mitsuba(&args)?.number("total_s").unwrap_or(f64::NAN);
+        std::fs::write(&key_path, &key)?;
+        t
+    };
+    let reference = read_rgb(&reference_path)?;
+    let reference_var = read_rgb(&reference_path.with_extension("var.exr"))?;
+    let n = reference.pixels.len() as f64;
+    let reference_noise = reference_var
+        .pixels
+        .iter()
+        .map(|&v| f64::from(v))
+        .sum::<f64>()
+        / n;
+    let mse_of = |img: &[f32]| -> f64 {
+        let raw = img
+            .iter()
+            .zip(&reference.pixels)
+            .map(|(&a, &b)| (f64::from(a) - f64::from(b)).powi(2))
+            .sum::<f64>()
+            / n;
+        raw - reference_noise
+    };
+
+    let file = load_scene(SCENE)?;
+    let configs = [
+        Config::Lueur(SamplerKind::Independent),
+        Config::Lueur(SamplerKind::default()),
+        Config::Mitsuba {
+            variant: "scalar_rgb",
+            sampler: "independent",
+        },
+        Config::Mitsuba {
+            variant: "llvm_ad_rgb",
+            sampler: "independent",
+        },
+        Config::Mitsuba {
+            variant: "llvm_ad_rgb",
+            sampler: "multijitter",
+        },
+        Config::Mitsuba {
+            variant: "llvm_ad_rgb",
+            sampler: "ldsampler",
+        },
+    ];
+    let mut results: Vec<(Config, Vec<Measured>)> = Vec::new();
+    let mut correctness = String::new();
+    for config in configs {
+        let mut rows = Vec::new();
+        for &spp in plan.spps {
+            let repeats = if spp == plan.timed_spp {
+                plan.repeats
+            } else {
+                1
+            };
+            let m = match config {
+                Config::Lueur(sampler) => {
+                    let settings = RenderSettings {
+                        width: plan.size,
+                        height: plan.size,
+                        spp,
+                        strategy: Strategy::Mis,
+                        sampler,
+                        ..file.settings.clone()
+                    };
+                    let mut times = Vec::new();
+                    let mut film = None;
+                    for _ in 0..repeats {
+                        let (f, t) = render_film(&file, &settings)?;
+                        times.push(t);
+                        film = Some(f);
+                    }
+                    let film = film.expect("one render");
+                    let img = flatten(&film.mean_image());
+                    if sampler == SamplerKind::Independent && spp == *plan.spps.last().unwrap() {
+                        correctness = compare(
+                            &img,
+                            &film.variance_image(),
+                            &reference,
+                            &reference_var,
+                            plan.size,
+                        )?;
+                    }
+                    Measured {
+                        spp,
+                        seconds: median(times),
+                        first_seconds: None,
+                        mse: mse_of(&img),
+                    }
+                }
+                Config::Mitsuba { variant, sampler } => {
+                    let out = work.join(format!("{variant}-{sampler}-{spp}.exr"));
+                    let mut args = vec![
+                        variant.to_string(),
+                        spp.to_string(),
+                        out.display().to_string(),
+                        "--sampler".into(),
+                        sampler.into(),
+                        "--repeats".into(),
+                        repeats.to_string(),
+                        "--width".into(),
+                        plan.size.to_string(),
+                        "--height".into(),
+                        plan.size.to_string(),
+                    ];
+                    args.extend(["--seed".into(), "0".into()]);
+                    let json = mitsuba(&args)?;
+                    let img = read_rgb(&out)?;
+                    Measured {
+                        spp,
+                        seconds: json.number("warm_s").context("warm_s")?,
+                        first_seconds: json.number("first_s"),
+                        mse: mse_of(&img.pixels),
+                    }
+                }
+            };
+            eprintln!(
+                "{:<36} {:>4} spp  {:>7.2} s  MSE {:.3e}",
+                config.name(),
+                spp,
+                m.seconds,
+                m.mse
+            );
+            rows.push(m);
+        }
+        results.push((config, rows));
+    }
+
+    let md = report(plan, &results, &correctness, reference_time)?;
+    let path = docs_dir(quick).join("PEERS.md");
+    std::fs::create_dir_all(path.parent().expect("a directory"))?;
+    std::fs::write(&path, md).with_context(|| format!("writing {}", path.display()))?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// lueur's image against the reference: per-channel means and a z-map
+/// over 8x8 regions.
+fn compare(
+    img: &[f32],
+    var: &[glam::Vec3],
+    reference: &Rgb,
+    reference_var: &Rgb,
+    size: u32,
+) -> Result<String> {
+    let size = size as usize;
+    ensure!(reference.width == size, "reference size");
+    let var = flatten(var);
+    let mut out = String::new();
+    let n = (size * size) as f64;
+    writeln!(
+        out,
+        "| channel | lueur | Mitsuba reference | difference | z |"
+    )?;
+    writeln!(out, "|---|---|---|---|---|")?;
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        let ch = |v: &[f32]| {
+            v.iter()
+                .skip(c)
+                .step_by(3)
+                .map(|&x| f64::from(x))
+                .sum::<f64>()
+        };
+        let (a, b) = (ch(img) / n, ch(&reference.pixels) / n);
+        let se = ((ch(&var) + ch(&reference_var.pixels)) / (n * n)).sqrt();
+        writeln!(
+            out,
+            "| {name} | {a:.5} | {b:.5} | {:+.3}% | {:+.1} |",
+            100.0 * (a - b) / b,
+            (a - b) / se
+        )?;
+    }
+    let region = 8;
+    let mut zs = Vec::new();
+    for ry in 0..size / region {
+        for rx in 0..size / region {
+            for c in 0..3 {
+                let (mut d, mut v) = (0.0, 0.0);
+                for y in ry * region..(ry + 1) * region {
+                    for x in rx * region..(rx + 1) * region {
+                        let i = 3 * (y * size + x) + c;
+                        d += f64::from(img[i]) - f64::from(reference.pixels[i]);
+                        v += f64::from(var[i]) + f64::from(reference_var.pixels[i]);
+                    }
+                }
+                if v > 0.0 {
+                    zs.push(d / v.sqrt());
+                }
+            }
+        }
+    }
+    let max = zs.iter().fold(0.0f64, |m, z| m.max(z.abs()));
+    let over4 = zs.iter().filter(|z| z.abs() > 4.0).count();
+    let below4 = zs.iter().filter(|z| **z < -4.0).count();
+    let rms = (zs.iter().map(|z| z * z).sum::<f64>() / zs.len() as f64).sqrt();
+    writeln!(
+        out,
+        "\nOver {} regions of {region}x{region} pixels x RGB: RMS z {rms:.2} (1 if the \
+         images differ by noise alone), max |z| {max:.1}, {over4} beyond 4, {below4} of them below -4 (for {} independent \
+         normals the largest |z| is about {:.1}).",
+        zs.len(),
+        zs.len(),
+        expected_max_z(zs.len())
+    )?;
+    Ok(out)
+}
+
+/// Roughly the median of the largest |z| among `k` standard normals.
+fn expected_max_z(k: usize) -> f64 {
+    (2.0 * (k as f64).ln()).sqrt()
+}
+
+fn report(
+    plan: &Plan,
+    results: &[(Config, Vec<Measured>)],
+    correctness: &str,
+    reference_time: f64,
+) -> Result<String> {
+    let mut md = String::new();
+    let size = plan.size;
+    writeln!(md, "# lueur and Mitsuba 3\n")?;
+    writeln!(
+        md,
+        "`cargo xtask peers` on `scenes/{SCENE}.toml` ({size}x{size}, max_depth 8, \
+         Russian roulette on), the shipped scene Mitsuba can express as it is: boxes, spheres, \
+         Lambertian and mirror materials, a sphere light. Mitsuba {} runs \
+         `xtask/peers/mitsuba_render.py`, which translates the scene file (its `path` \
+         integrator combines BSDF and emitter sampling by the power heuristic, as lueur's \
+         `mis` does). Both on this machine's 2 cores, in one run. Mitsuba is a peer for this \
+         report, never a dependency: the report refuses to run without it.\n",
+        mitsuba_version()
+    )?;
+    writeln!(md, "## Correctness\n")?;
+    writeln!(
+        md,
+        "lueur (`mis`, independent samples, {} spp) against a Mitsuba reference \
+         (`llvm_ad_rgb`, {} x {} spp, other seeds{}). The standard errors are both images' \
+         own.\n",
+        plan.spps.last().unwrap(),
+        plan.reference_passes,
+        plan.reference_pass_spp,
+        if reference_time.is_finite() {
+            format!("; {reference_time:.0} s")
+        } else {
+            String::new()
+        }
+    )?;
+    writeln!(md, "{correctness}")?;
+    writeln!(md, "## Speed and error\n")?;
+    writeln!(
+        md,
+        "Render time (lueur: its own measured render; Mitsuba: the render after a first one, \
+         so a JIT variant's kernel compile, shown apart, is not counted), median of {} at {} spp. \
+         MSE against the reference, less the reference's own variance. **MSE x time** is what \
+         a given error costs: the time to reach an error is proportional to it (lower is \
+         better).\n",
+        plan.repeats, plan.timed_spp
+    )?;
+    writeln!(
+        md,
+        "| configuration | spp | time | M samples/s | MSE | MSE x time |"
+    )?;
+    writeln!(md, "|---|---|---|---|---|---|")?;
+    let pixels = f64::from(size * size);
+    for (config, rows) in results {
+        for m in rows {
+            let first = match m.first_seconds {
+                Some(f) if matches!(config, Config::Mitsuba { variant, .. } if variant.starts_with("llvm")) =>
+                {
+                    format!(" (first: {f:.2} s)")
+                }
+                _ => String::new(),
+            };
+            writeln!(
+                md,
+                "| {} | {} | {:.2} s{first} | {:.2} | {:.3e} | {:.3e} |",
+                config.name(),
+                m.spp,
+                m.seconds,
+                pixels * f64::from(m.spp) / m.seconds / 1e6,
+                m.mse,
+                m.mse * m.seconds
+            )?;
+        }
+    }
+    // The headline: lueur's default against Mitsuba's fastest, at the timed
+    // spp and at the largest.
+    let find = |pred: &dyn Fn(&Config) -> bool| results.iter().find(|(c, _)| pred(c));
+    let lueur = find(&|c| matches!(c, Config::Lueur(s) if *s == SamplerKind::default()));
+    let best_mitsuba = results
+        .iter()
+        .filter(|(c, _)| matches!(c, Config::Mitsuba { .. }))
+        .min_by(|a, b| {
+            let last = |r: &Vec<Measured>| {
+                let m = r.last().expect("rows");
+                m.mse * m.seconds
+            };
+            last(&a.1).total_cmp(&last(&b.1))
+        });
+    if let (Some((lc, lr)), Some((mc, mr))) = (lueur, best_mitsuba) {
+        let at =
+            |r: &[Measured], spp: u32| r.iter().find(|m| m.spp == spp).map(|m| (m.seconds, m.mse));
+        writeln!(
+            md,
+            "\n**Summary**, {} against {} (the Mitsuba configuration with the lowest MSE x time at {} spp):\n",
+            lc.name(),
+            mc.name(),
+            plan.spps.last().unwrap()
+        )?;
+        for &spp in plan.spps {
+            if let (Some((lt, le)), Some((mt, me))) = (at(lr, spp), at(mr, spp)) {
+                writeln!(
+                    md,
+                    "- {spp} spp: lueur takes {:.2}x Mitsuba's time per sample; its MSE x time is {:.2}x Mitsuba's.",
+                    lt / mt,
+                    (le * lt) / (me * mt)
+                )?;
+            }
+        }
+    }
+    Ok(md)
+}
+
+fn mitsuba_version() -> String {
+    python()
+        .args(["-c", "import mitsuba; print(mitsuba.__version__)"])
+        .output()
+        .ok()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned())
+        .unwrap_or_else(|| "3".into())
+}
