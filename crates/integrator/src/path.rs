@@ -85,7 +85,8 @@ impl March {
 }
 
 /// A hit made usable for shading: the tracer stops anywhere in a shell of
-/// width `epsilon` around the surface (a quarter pixel for camera rays), so
+/// width `epsilon` around the surface (a sixteenth of a pixel for camera
+/// rays, by default), so
 /// shading there would measure light from the wrong point. One Newton step
 /// *along the ray* moves the point onto the surface where the ray crosses
 /// it; rays leave from just above it, by an offset that covers what the
@@ -131,7 +132,7 @@ impl SurfacePoint {
         let reach = 4.0 * epsilon.max(spawn_floor);
         // The difference step is an eighth of the hit shell: finite
         // differences blur a crease (the Death Star's rim) over about h,
-        // and at the shell's width (a quarter pixel for camera rays) that
+        // and at the shell's width (then a quarter pixel for camera rays) that
         // blur biased whole rows of rim pixels, differently for the
         // tetrahedron and for central differences (measured: z = 7 between
         // the two at 32x32, 256 spp). Smooth surfaces do not care: their
