@@ -393,6 +393,14 @@ fn run_render(args: RenderArgs) -> Result<()> {
         Some(_) => format!("samples {:?} of {}", output.film.samples(), settings.spp),
         None => format!("{} spp", output.film.spp()),
     };
+    let samples = match output.film.unfinished_pass() {
+        Some((pass, share)) => format!(
+            "{samples} ({:.0}% of the pixels at {})",
+            100.0 * share,
+            pass.end - output.film.samples().start
+        ),
+        None => samples,
+    };
     let destination = out.as_ref().or(args.checkpoint.as_ref());
     eprintln!(
         "rendered {}x{} at {samples} ({}, {}) in {:.2} s, {:.2} M samples/s -> {}",
