@@ -195,19 +195,26 @@ impl SphericalRectangle {
         let v01 = DVec3::new(x0, y1, z0);
         let v10 = DVec3::new(x1, y0, z0);
         let v11 = DVec3::new(x1, y1, z0);
+        // n1 and n3 only enter angles, which do not need unit normals.
         let n0 = v00.cross(v10).normalize();
-        let n1 = v10.cross(v11).normalize();
+        let n1 = v10.cross(v11);
         let n2 = v11.cross(v01).normalize();
-        let n3 = v01.cross(v00).normalize();
-        // Interior angle between consecutive edges: acos(-n_i . n_j), written
-        // as atan2(|n_i x n_j|, -n_i . n_j) for accuracy near 0 and pi.
-        let angle = |a: DVec3, b: DVec3| a.cross(b).length().atan2(-a.dot(b));
-        let g0 = angle(n0, n1);
-        let g1 = angle(n1, n2);
-        let g2 = angle(n2, n3);
-        let g3 = angle(n3, n0);
-        let k = TAU - g2 - g3;
-        let solid_angle = g0 + g1 - k;
+        let n3 = v01.cross(v00);
+        // Interior angle between consecutive edges: acos(-n_i . n_j), i.e.
+        // the argument of (-n_i . n_j, |n_i x n_j|), accurate near 0 and pi
+        // where acos is not. The algorithm needs only g0 + g1 and g2 + g3:
+        // each is the argument of a product of two such complex numbers,
+        // one atan2 instead of two (the sums lie in (0, 2pi); atan2 returns
+        // (-pi, pi], hence the wrap).
+        let turn = |a: DVec3, b: DVec3| (-a.dot(b), a.cross(b).length());
+        let sum_of_angles = |(c0, s0): (f64, f64), (c1, s1): (f64, f64)| {
+            let angle = (c0 * s1 + s0 * c1).atan2(c0 * c1 - s0 * s1);
+            if angle <= 0.0 { angle + TAU } else { angle }
+        };
+        let g01 = sum_of_angles(turn(n0, n1), turn(n1, n2));
+        let g23 = sum_of_angles(turn(n2, n3), turn(n3, n0));
+        let k = TAU - g23;
+        let solid_angle = g01 - k;
         if !(solid_angle.is_finite() && solid_angle >= f64::from(Self::MIN_SOLID_ANGLE)) {
             return None;
         }
@@ -425,5 +432,47 @@ mod tests {
                 .unwrap();
         let expected = 4.0 * (0.25f64 / 1.25).asin();
         assert!((f64::from(rect.solid_angle()) - expected).abs() < 1e-6);
+    }
+
+    /// The solid angle against an independent formula, two triangles by Van
+    /// Oosterom and Strackee (1983), `tan(omega / 2) = |a.(b x c)| / (abc +
+    /// (a.b)c + (a.c)b + (b.c)a)`, over rectangles seen from overhead, from
+    /// grazing heights (solid angle near 2 pi), tiny and far away.
+    #[test]
+    fn solid_angle_matches_two_triangles_everywhere() {
+        let triangle = |a: DVec3, b: DVec3, c: DVec3| {
+            let (la, lb, lc) = (a.length(), b.length(), c.length());
+            let numerator = a.dot(b.cross(c)).abs();
+            let denominator = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+            2.0 * numerator.atan2(denominator)
+        };
+        let mut checked = 0;
+        for (size, height) in [
+            (1.0f32, 1.0f32),
+            (1.0, 1e-3),
+            (1.0, 0.05),
+            (1e-2, 1.0),
+            (1.0, 30.0),
+            (4.0, 0.5),
+        ] {
+            for (dx, dy) in [(0.0f32, 0.0f32), (0.3, -0.2), (2.0, 1.5), (-5.0, 0.1)] {
+                let p = Vec3::new(dx * size, dy * size, 0.0);
+                let corner = Vec3::new(-0.5 * size, 0.5 * size, height);
+                let (eu, ev) = (Vec3::X * size, -Vec3::Y * 1.5 * size);
+                let Some(rect) = SphericalRectangle::new(p, corner, eu, ev) else {
+                    continue;
+                };
+                let v = |s: f32, t: f32| (corner + s * eu + t * ev - p).as_dvec3();
+                let expected = triangle(v(0.0, 0.0), v(1.0, 0.0), v(1.0, 1.0))
+                    + triangle(v(0.0, 0.0), v(1.0, 1.0), v(0.0, 1.0));
+                let got = f64::from(rect.solid_angle());
+                assert!(
+                    (got - expected).abs() <= 1e-6 * expected.max(1e-3),
+                    "size {size} height {height} offset ({dx}, {dy}): {got} vs {expected}"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked >= 20, "{checked}");
     }
 }
