@@ -342,8 +342,9 @@ fn spawn_long_render(dir: &Path, size: u32) -> std::process::Child {
         .unwrap()
 }
 
-/// A signal mid-render: the last complete pass is written, a whole number
-/// of spp, and the exit status says the render did not finish.
+/// A signal mid-render: what was rendered is written (the last complete
+/// pass, and the tiles of the next one that finished: every pixel a whole
+/// number of samples), and the exit status says the render did not finish.
 #[cfg(unix)]
 fn interrupt_with(signal: &str) {
     use std::time::{Duration, Instant};
@@ -373,21 +374,21 @@ fn interrupt_with(signal: &str) {
 
 #[cfg(unix)]
 #[test]
-fn sigint_writes_the_last_complete_pass_and_exits_130() {
+fn sigint_writes_what_was_rendered_and_exits_130() {
     interrupt_with("INT");
 }
 
 /// What batch systems send at a job's time limit (Slurm: SIGTERM).
 #[cfg(unix)]
 #[test]
-fn sigterm_writes_the_last_complete_pass_and_exits_130() {
+fn sigterm_writes_what_was_rendered_and_exits_130() {
     interrupt_with("TERM");
 }
 
 /// What a closed terminal or ssh session sends.
 #[cfg(unix)]
 #[test]
-fn sighup_writes_the_last_complete_pass_and_exits_130() {
+fn sighup_writes_what_was_rendered_and_exits_130() {
     interrupt_with("HUP");
 }
 
