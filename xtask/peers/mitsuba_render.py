@@ -63,7 +63,7 @@ def translate(scene, args, mi):
     cam = scene["camera"]
     d = {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": depth + 1, "rr_depth": 4},
+        "integrator": {"type": "path", "max_depth": depth + 1, "rr_depth": args.rr_depth},
         "sensor": {
             "type": "perspective",
             "fov": cam.get("vfov", 40.0),
@@ -130,6 +130,9 @@ def main():
     p.add_argument("--width", type=int)
     p.add_argument("--height", type=int)
     p.add_argument("--max-depth", type=int)
+    # Mitsuba's default is 5; 4 starts roulette after about as many
+    # bounces as lueur's default roulette_depth 3. A large value turns it off.
+    p.add_argument("--rr-depth", type=int, default=4)
     args = p.parse_args()
 
     import drjit as dr
