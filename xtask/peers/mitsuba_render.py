@@ -3,8 +3,8 @@
 Translates what both renderers can express (boxes, spheres, Lambertian and
 mirror materials, sphere and quad lights, a pinhole camera) and refuses the
 rest, renders with Mitsuba's `path` integrator (BSDF and emitter sampling
-combined by the power heuristic: lueur's `mis`), and prints one JSON line
-of timings. Never a build or test dependency of lueur: only the xtask
+combined by the power heuristic: lueur's `mis`), and prints its timings as
+`key value` lines. Never a build or test dependency of lueur: only the xtask
 report runs it, and only where `pip install mitsuba` was done.
 
 Conventions matched (checked by the report: the two converged images agree
@@ -27,7 +27,6 @@ variance of that mean, per pixel, from the spread of the passes.
 """
 
 import argparse
-import json
 import sys
 import time
 import tomllib
@@ -157,8 +156,7 @@ def main():
         var_of_mean = stack.var(axis=0, ddof=1) / args.passes if args.passes > 1 else 0 * mean
         mi.Bitmap(mean.astype(np.float32)).write(args.out)
         mi.Bitmap(var_of_mean.astype(np.float32)).write(args.out[: -len(".exr")] + ".var.exr")
-        print(json.dumps({"variant": args.variant, "spp": args.spp * args.passes,
-                          "total_s": time.perf_counter() - t0}))
+        report(spp=args.spp * args.passes, total_s=time.perf_counter() - t0)
         return
     times = []
     img = None
@@ -174,17 +172,14 @@ def main():
     # kernel (cached on disk after a first run); it is reported apart.
     bitmap = mi.Bitmap(img)
     bitmap.write(args.out)
-    print(
-        json.dumps(
-            {
-                "variant": args.variant,
-                "spp": args.spp,
-                "load_s": load_s,
-                "first_s": times[0],
-                "warm_s": sorted(times[1:])[len(times[1:]) // 2] if len(times) > 1 else times[0],
-            }
-        )
-    )
+    warm = sorted(times[1:])[len(times[1:]) // 2] if len(times) > 1 else times[0]
+    report(spp=args.spp, load_s=load_s, first_s=times[0], warm_s=warm)
+
+
+def report(**numbers):
+    """One `key value` line per number on stdout: what the xtask reads."""
+    for key, value in numbers.items():
+        print(f"{key} {value}")
 
 
 if __name__ == "__main__":

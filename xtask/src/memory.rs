@@ -96,7 +96,7 @@ fn build_lueur() -> Result<PathBuf> {
 pub fn run(quick: bool) -> Result<()> {
     let lueur = build_lueur()?;
     let (w, h) = if quick { (480, 270) } else { (3840, 2160) };
-    let work = tempfile_dir()?;
+    let work = scratch_dir()?;
     let file = |name: &str| work.join(name).display().to_string();
     let size = |spp: u32| {
         vec![
@@ -236,7 +236,7 @@ pub fn run(quick: bool) -> Result<()> {
 
 /// A scratch directory under the target directory (4K checkpoints are
 /// 150 MB each; /tmp may be small).
-fn tempfile_dir() -> Result<PathBuf> {
+fn scratch_dir() -> Result<PathBuf> {
     let dir = crate::reference::cache_dir()?.join("memory");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;

@@ -20,6 +20,7 @@
 //!    for a given error is proportional to it) compare in one run.
 //!    Writes `docs/PEERS.md`.
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -133,8 +134,9 @@ fn scene_path() -> PathBuf {
     project_root().join("scenes").join(format!("{SCENE}.toml"))
 }
 
-/// Runs the Mitsuba script; returns its JSON line's numbers by key.
-fn mitsuba(args: &[String]) -> Result<serde_like::Json> {
+/// Runs the Mitsuba script; returns the numbers it prints, one `key
+/// value` line each.
+fn mitsuba(args: &[String]) -> Result<HashMap<String, f64>> {
     let out = python()
         .arg(script())
         .arg(scene_path())
@@ -148,26 +150,13 @@ fn mitsuba(args: &[String]) -> Result<serde_like::Json> {
             String::from_utf8_lossy(&out.stderr)
         );
     }
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let line = stdout
+    Ok(String::from_utf8_lossy(&out.stdout)
         .lines()
-        .last()
-        .context("no output from mitsuba_render.py")?;
-    Ok(serde_like::Json(line.to_owned()))
-}
-
-/// The few numbers read back from the script's one-line JSON (no JSON
-/// crate for three keys of a line we write ourselves).
-mod serde_like {
-    pub struct Json(pub String);
-    impl Json {
-        pub fn number(&self, key: &str) -> Option<f64> {
-            let at = self.0.find(&format!("\"{key}\": "))? + key.len() + 4;
-            let rest = &self.0[at..];
-            let end = rest.find([',', '}']).unwrap_or(rest.len());
-            rest[..end].trim().parse().ok()
-        }
-    }
+        .filter_map(|line| {
+            let (key, value) = line.split_once(' ')?;
+            Some((key.to_owned(), value.trim().parse().ok()?))
+        })
+        .collect())
 }
 
 pub fn run(quick: bool) -> Result<()> {
@@ -220,7 +209,7 @@ pub fn run(quick: bool) -> Result<()> {
         eprintln!("reference: cached in {}", reference_path.display());
         f64::NAN
     } else {
-        let t = mitsuba(&args)?.number("total_s").unwrap_or(f64::NAN);
+        let t = mitsuba(&args)?.get("total_s").copied().unwrap_or(f64::NAN);
         std::fs::write(&key_path, &key)?;
         t
     };
@@ -341,12 +330,14 @@ pub fn run(quick: bool) -> Result<()> {
                         plan.size.to_string(),
                     ];
                     args.extend(["--seed".into(), "0".into()]);
-                    let json = mitsuba(&args)?;
+                    let numbers = mitsuba(&args)?;
                     let img = read_rgb(&out)?;
                     Measured {
                         spp,
-                        seconds: json.number("warm_s").context("warm_s")?,
-                        first_seconds: json.number("first_s"),
+                        seconds: *numbers
+                            .get("warm_s")
+                            .context("no warm_s from mitsuba_render.py")?,
+                        first_seconds: numbers.get("first_s").copied(),
                         mse: mse_of(&img.pixels),
                     }
                 }
