@@ -9,6 +9,7 @@ mod plot;
 mod pointset_figures;
 mod reference;
 mod samplers;
+mod scale;
 mod spectrum;
 mod tradeoff;
 mod variance;
@@ -78,6 +79,14 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Check that a small light's answer does not depend on the size of the
+    /// floor under it, nor on the scene's scale or distance from the origin;
+    /// writes docs/SCALE.md.
+    Scale {
+        /// Fewer sizes and samples, for CI.
+        #[arg(long)]
+        quick: bool,
+    },
     /// Run a command and print its peak resident set in kB (used by
     /// `memory`, one process per measurement).
     #[command(hide = true)]
@@ -95,6 +104,7 @@ fn main() -> Result<()> {
         Command::Samplers { quick, report_only } => samplers::run(quick, report_only),
         Command::Memory { quick } => memory::run(quick),
         Command::Peers { quick } => peers::run(quick),
+        Command::Scale { quick } => scale::run(quick),
         Command::MemoryProbe { command } => memory::probe(&command),
     }
 }

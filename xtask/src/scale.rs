@@ -1,0 +1,282 @@
+//! `cargo xtask scale`: does a small light's answer depend on how big the rest of the scene
+//! is? A Lambertian floor (albedo 0.5) under a sphere light or a square quad light, with
+//! the floor's half-extent from 1 to 10^4, an unbounded plane with one object 2000 away,
+//! and the same scenes scaled by 1e-3 and 1e3 and moved 1e4 from the origin. The camera
+//! sees a small patch right below the light, where the closed form holds; every
+//! strategy's patch mean is compared with it. Writes docs/SCALE.md.
+
+use std::fmt::Write as _;
+
+use anyhow::{Context, Result};
+use lueur::integrator::{RenderSettings, Strategy};
+use lueur::sampling::SamplerKind;
+use lueur::scene::parse_scene;
+
+use crate::{docs_dir, render_with_bar};
+
+/// The floor's albedo, the lights' radiance, and where they are (issue 14's scene).
+const ALBEDO: f64 = 0.5;
+const RADIANCE: f64 = 16.0;
+const HEIGHT: f64 = 1.0;
+const SPHERE_RADIUS: f64 = 0.25;
+/// Half the side of the square light.
+const QUAD_HALF: f64 = 0.25;
+
+#[derive(Clone, Copy, PartialEq)]
+enum LightKind {
+    Sphere,
+    Quad,
+}
+
+impl LightKind {
+    fn name(self) -> &'static str {
+        match self {
+            LightKind::Sphere => "sphere",
+            LightKind::Quad => "quad",
+        }
+    }
+
+    /// Radiance leaving the floor right below the light, in closed form.
+    fn expected(self) -> f64 {
+        match self {
+            // Irradiance pi L sin^2(theta) with sin(theta) = r / h, times albedo / pi.
+            LightKind::Sphere => ALBEDO * RADIANCE * SPHERE_RADIUS.powi(2) / HEIGHT.powi(2),
+            // The view factor to a parallel square of side 2a at height c, four quadrants
+            // (Howell's catalogue, B-3), as in tests/analytic.rs.
+            LightKind::Quad => {
+                let x = QUAD_HALF / HEIGHT;
+                let s = (1.0 + x * x).sqrt();
+                let f = 4.0 / (2.0 * std::f64::consts::PI) * 2.0 * (x / s * (x / s).atan());
+                ALBEDO * RADIANCE * f
+            }
+        }
+    }
+}
+
+/// What lies under the light.
+#[derive(Clone, Copy)]
+enum Ground {
+    /// A box 0.1 thick whose top face is the floor, of this half-extent.
+    Floor(f64),
+    /// An unbounded plane, and a unit sphere 2000 away.
+    PlaneAndFarObject,
+}
+
+impl Ground {
+    fn label(self) -> String {
+        match self {
+            Ground::Floor(h) => format!("floor half-extent {h}"),
+            Ground::PlaneAndFarObject => "plane + object 2000 away".into(),
+        }
+    }
+}
+
+/// `p -> scale p + offset`, applied to every position and length.
+#[derive(Clone, Copy)]
+struct Frame {
+    scale: f64,
+    offset: f64,
+    label: &'static str,
+}
+
+const FRAMES: [Frame; 4] = [
+    Frame {
+        scale: 1.0,
+        offset: 0.0,
+        label: "as is",
+    },
+    Frame {
+        scale: 1e-3,
+        offset: 0.0,
+        label: "scaled 1e-3",
+    },
+    Frame {
+        scale: 1e3,
+        offset: 0.0,
+        label: "scaled 1e3",
+    },
+    Frame {
+        scale: 1.0,
+        // 1e4 from the origin along the diagonal.
+        offset: 1e4 / 1.732_050_8,
+        label: "moved 1e4",
+    },
+];
+
+impl Frame {
+    fn point(&self, x: f64, y: f64, z: f64) -> String {
+        let f = |v: f64| v * self.scale + self.offset;
+        format!("[{:e}, {:e}, {:e}]", f(x), f(y), f(z))
+    }
+
+    fn vector(&self, x: f64, y: f64, z: f64) -> String {
+        let f = |v: f64| v * self.scale;
+        format!("[{:e}, {:e}, {:e}]", f(x), f(y), f(z))
+    }
+}
+
+/// The scene's text: the floor's top at y = 0, the light above the origin, a camera with
+/// a field of view of 0.05 degrees looking at the origin from 3.2 away.
+fn scene_text(light: LightKind, ground: Ground, frame: Frame) -> String {
+    let ground = match ground {
+        Ground::Floor(h) => format!(
+            "[[objects]]\nmaterial = \"floor\"\nshape = {{ type = \"box\", center = {}, half_extents = {} }}\n",
+            frame.point(0.0, -0.05, 0.0),
+            frame.vector(h, 0.05, h),
+        ),
+        Ground::PlaneAndFarObject => {
+            // The plane y = offset, through the frame's image of the origin.
+            let height = frame.offset;
+            format!(
+                "[[objects]]\nmaterial = \"floor\"\nshape = {{ type = \"plane\", normal = [0.0, 1.0, 0.0], height = {height:e} }}\n\
+                 [[objects]]\nmaterial = \"floor\"\nshape = {{ type = \"sphere\", center = {}, radius = {:e} }}\n",
+                frame.point(2000.0, 1.0, 0.0),
+                frame.scale,
+            )
+        }
+    };
+    let light = match light {
+        LightKind::Sphere => format!(
+            "[[lights]]\ntype = \"sphere\"\ncenter = {}\nradius = {:e}\nradiance = [{RADIANCE}, {RADIANCE}, {RADIANCE}]\n",
+            frame.point(0.0, HEIGHT, 0.0),
+            SPHERE_RADIUS * frame.scale,
+        ),
+        LightKind::Quad => format!(
+            "[[lights]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\nradiance = [{RADIANCE}, {RADIANCE}, {RADIANCE}]\n",
+            frame.point(-QUAD_HALF, HEIGHT, -QUAD_HALF),
+            // edge_u x edge_v points down: the side that emits.
+            frame.vector(2.0 * QUAD_HALF, 0.0, 0.0),
+            frame.vector(0.0, 0.0, 2.0 * QUAD_HALF),
+        ),
+    };
+    format!(
+        "[camera]\nposition = {}\nlook_at = {}\nvfov = 0.05\n\
+         [materials]\nfloor = {{ type = \"lambertian\", albedo = [{ALBEDO}, {ALBEDO}, {ALBEDO}] }}\n\
+         {ground}{light}",
+        frame.point(0.0, 1.0, 3.0),
+        frame.point(0.0, 0.0, 0.0),
+    )
+}
+
+/// One measurement: the patch's mean radiance (green channel) and its standard error.
+struct Measured {
+    mean: f64,
+    stderr: f64,
+}
+
+fn measure(
+    light: LightKind,
+    ground: Ground,
+    frame: Frame,
+    strategy: Strategy,
+    spp: u32,
+) -> Result<Measured> {
+    let text = scene_text(light, ground, frame);
+    let file = parse_scene(&text, "scale.toml").context("the generated scene")?;
+    let settings = RenderSettings {
+        width: 8,
+        height: 8,
+        spp,
+        strategy,
+        sampler: SamplerKind::Independent,
+        max_depth: 1,
+        seed: 14,
+        ..file.settings.clone()
+    };
+    let label = format!("{} {} {strategy}", light.name(), ground.label());
+    let film = render_with_bar(&file.scene, &settings, &label)?;
+    // One channel: the three are the same numbers here, so averaging them would claim a
+    // standard error sqrt(3) too small.
+    let n = film.pixels().len() as f64;
+    let mean = film.pixels().map(|p| f64::from(p.mean.y)).sum::<f64>() / n;
+    let var = film
+        .pixels()
+        .map(|p| f64::from(p.variance_of_mean().y))
+        .sum::<f64>()
+        / (n * n);
+    Ok(Measured {
+        mean,
+        stderr: var.sqrt(),
+    })
+}
+
+const STRATEGIES: [Strategy; 5] = [
+    Strategy::Uniform,
+    Strategy::Cosine,
+    Strategy::Light,
+    Strategy::Mixture,
+    Strategy::Mis,
+];
+
+/// One row: every strategy's relative error (and z) on one scene.
+fn row(out: &mut String, label: &str, light: LightKind, cases: &[Measured]) {
+    let expected = light.expected();
+    let cells: Vec<String> = cases
+        .iter()
+        .map(|m| {
+            let rel = (m.mean - expected) / expected;
+            if m.stderr > 0.0 {
+                let z = (m.mean - expected) / m.stderr;
+                format!("{:+.2}% (z {:+.1})", 100.0 * rel, z)
+            } else {
+                format!("{:+.2}% (no variance)", 100.0 * rel)
+            }
+        })
+        .collect();
+    let _ = writeln!(out, "| {label} | {} |", cells.join(" | "));
+}
+
+pub fn run(quick: bool) -> Result<()> {
+    let spp = if quick { 1024 } else { 16384 };
+    let sizes: &[f64] = if quick {
+        &[1.0, 1000.0]
+    } else {
+        &[1.0, 10.0, 100.0, 1000.0, 10000.0]
+    };
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "# Scale-free tracing\n\nGenerated by `cargo xtask scale`. A Lambertian floor \
+         (albedo {ALBEDO}) under a light of radiance {RADIANCE} at height {HEIGHT} (a sphere of \
+         radius {SPHERE_RADIUS}, or a square of side {}), `max_depth = 1`, 8x8 pixels of a \
+         0.05-degree camera looking at the point below the light, {spp} spp, independent \
+         samples, seed 14. Each cell is the patch mean's relative error against the closed \
+         form, and its z-score (green channel). `light` sees everything at depth 1, so every \
+         strategy is unbiased here.\n",
+        2.0 * QUAD_HALF
+    );
+    let header = format!(
+        "| scene | {} |\n|---|{}",
+        STRATEGIES.map(|s| s.to_string()).join(" | "),
+        "---|".repeat(STRATEGIES.len())
+    );
+    for light in [LightKind::Sphere, LightKind::Quad] {
+        let _ = writeln!(
+            out,
+            "## {} light (closed form {:.5})\n\n{header}",
+            light.name(),
+            light.expected()
+        );
+        let mut grounds: Vec<Ground> = sizes.iter().map(|&h| Ground::Floor(h)).collect();
+        grounds.push(Ground::PlaneAndFarObject);
+        for ground in grounds {
+            let frames: &[Frame] = if quick { &FRAMES[..1] } else { &FRAMES };
+            for frame in frames {
+                let cases = STRATEGIES
+                    .iter()
+                    .map(|&s| measure(light, ground, *frame, s, spp))
+                    .collect::<Result<Vec<_>>>()?;
+                let label = format!("{}, {}", ground.label(), frame.label);
+                row(&mut out, &label, light, &cases);
+            }
+        }
+        out.push('\n');
+    }
+    let dir = docs_dir(quick);
+    std::fs::create_dir_all(&dir)?;
+    let path = dir.join("SCALE.md");
+    std::fs::write(&path, &out).with_context(|| format!("writing {}", path.display()))?;
+    print!("{out}");
+    println!("wrote {}", path.display());
+    Ok(())
+}
