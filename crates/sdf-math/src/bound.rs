@@ -116,7 +116,6 @@ pub struct RayClip {
     /// A non-finite origin or direction: every clip keeps the whole range.
     degenerate: bool,
     /// The largest coordinate of the origin: the rounding of positions near it.
-    origin_size: f32,
     eps_abs: f32,
     eps_rel: f32,
     t_min: f32,
@@ -222,7 +221,6 @@ impl RayClip {
                 Slope::new(-d - rel),
             ],
             degenerate: !(ray.origin.is_finite() && ray.dir.is_finite()),
-            origin_size: ray.origin.abs().max_element(),
             eps_abs: params.eps_abs.max(0.0),
             eps_rel,
             t_min: params.t_min,
@@ -239,9 +237,12 @@ impl RayClip {
             return Some((self.t_min, self.t_max));
         }
         let (min, max) = (Vec3A::from(aabb.min), Vec3A::from(aabb.max));
-        // Taken off every plane value: the f32 rounding of positions this far out.
-        let size = self.origin_size + min.abs().max(max.abs()).max_element();
-        let rounding = Vec3A::splat(16.0 * f32::EPSILON * size);
+        // Taken off every plane value: the f32 rounding of the numbers that decide it, per
+        // axis (the origin's coordinate and the box's faces on that axis). Per axis, not
+        // the largest coordinate of all, so that a ray leaving the top of a floor 1e4 wide
+        // is not a candidate for it however close above it starts.
+        let rounding =
+            Vec3A::splat(4.0 * f32::EPSILON) * self.origin.abs().max(min.abs()).max(max.abs());
         let eps_abs = Vec3A::splat(self.eps_abs);
         let up = self.origin - max - rounding;
         let down = min - self.origin - rounding;
@@ -263,9 +264,8 @@ impl RayClip {
     /// (the field is at least the plane's value, whatever its scale).
     #[inline]
     pub fn clip_half_space(&self, h: &HalfSpace) -> Option<(f32, f32)> {
-        let rounding = 16.0
-            * f32::EPSILON
-            * (self.origin_size * h.normal.abs().element_sum() + h.height.abs());
+        let terms = h.normal.abs() * Vec3::from(self.origin.abs());
+        let rounding = 4.0 * f32::EPSILON * (terms.element_sum() + h.height.abs());
         let a = h.value(self.origin.into()) - rounding;
         let b = self.dir.dot(h.normal);
         let b_rel = b - self.eps_rel;

@@ -64,5 +64,6 @@ pub use crate::prepared::PreparedSdf;
 pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
 pub use crate::trace::{
-    OVER_RELAXATION, TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed,
+    HIT_ULPS, OVER_RELAXATION, TraceOutcome, TraceParams, position_rounding, sphere_trace,
+    sphere_trace_relaxed,
 };

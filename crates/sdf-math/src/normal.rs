@@ -1,6 +1,6 @@
 //! Surface normals as normalised finite-difference gradients of a distance field.
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 use crate::DistanceField;
 
@@ -26,8 +26,8 @@ pub fn normal<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
 ///
 /// Unlike [`normal`] this may be zero or non-finite; callers must check.
 pub fn gradient<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
-    // iq, "normalsSDF": the vertices of a tetrahedron sum to zero, so sum_i k_i f(p + h k_i)
-    // is proportional to the gradient, with one evaluation fewer than central differences.
+    // iq, "normalsSDF": the vertices of a tetrahedron around p, one evaluation fewer than
+    // central differences.
     const K: [Vec3; 4] = [
         Vec3::new(1.0, -1.0, -1.0),
         Vec3::new(-1.0, -1.0, 1.0),
@@ -35,34 +35,45 @@ pub fn gradient<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
         Vec3::new(1.0, 1.0, 1.0),
     ];
     let h = usable_step(p, h);
-    // sum_i k_i (k_i . grad) h = 4 h grad, since sum_i k_i k_i^T = 4 I.
-    K.iter()
-        .fold(Vec3::ZERO, |acc, &k| acc + k * field.distance(p + k * h))
-        / (4.0 * h)
+    // The points actually sampled are p + h k rounded to f32, which far from the origin
+    // differ from p + h k by up to half an ulp of p: as much as 6% of h at the smallest
+    // step. Their differences are exact (they are close to each other), so the gradient
+    // of the linear function through the four samples, solved with the real offsets,
+    // carries only the field's own rounding. With exact offsets it is iq's
+    // sum_i k_i f(p + h k_i) / (4 h).
+    let q = K.map(|k| p + k * h);
+    let f = q.map(|x| field.distance(x));
+    let offsets = Mat3::from_cols(q[0] - q[3], q[1] - q[3], q[2] - q[3]).transpose();
+    let rises = Vec3::new(f[0] - f[3], f[1] - f[3], f[2] - f[3]);
+    offsets.inverse() * rises
 }
 
 /// The gradient by central differences (6 evaluations), not normalised: the naive
 /// reference for [`gradient`], with the same treatment of `h` and the same caveat.
 pub fn gradient_central<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
     let h = usable_step(p, h);
-    let d = |e: Vec3| field.distance(p + e * h) - field.distance(p - e * h);
-    Vec3::new(d(Vec3::X), d(Vec3::Y), d(Vec3::Z)) / (2.0 * h)
+    // Divided by the distance between the points actually sampled (see [`gradient`]).
+    let d = |e: Vec3| {
+        let (a, b) = (p + e * h, p - e * h);
+        (field.distance(a) - field.distance(b)) / (a - b).dot(e)
+    };
+    Vec3::new(d(Vec3::X), d(Vec3::Y), d(Vec3::Z))
 }
 
 /// Central differences (6 evaluations), kept as the naive reference for [`normal`].
 ///
 /// Same guarantees and the same treatment of `h` as [`normal`].
 pub fn normal_central<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
-    let h = usable_step(p, h);
-    let d = |e: Vec3| field.distance(p + e * h) - field.distance(p - e * h);
-    unit_or_fallback(Vec3::new(d(Vec3::X), d(Vec3::Y), d(Vec3::Z)))
+    unit_or_fallback(gradient_central(field, p, h))
 }
 
-/// `|h|`, but at least 8 ulps of the largest coordinate of `p` (and 0 for a NaN `h` at the
-/// origin, which then takes the fallback path rather than producing NaN).
+/// `|h|`, but at least two ulps of the largest coordinate of `p` (and 0 for a NaN `h` at
+/// the origin, which then takes the fallback path rather than producing NaN): below that
+/// `p + h` may round back to `p`. No more is needed, since the estimators use the offsets
+/// their samples really have.
 #[inline]
 fn usable_step(p: Vec3, h: f32) -> f32 {
-    let floor = p.abs().max_element() * (8.0 * f32::EPSILON);
+    let floor = p.abs().max_element() * (2.0 * f32::EPSILON);
     let h = h.abs();
     if h >= floor { h } else { floor }
 }
@@ -146,6 +157,44 @@ mod tests {
                     (grad - g).length() < 1e-3 * (1.0 + p.length() * 1e-2),
                     "{p}: {grad}"
                 );
+            }
+        }
+    }
+
+    /// A sphere of radius 50 about 1e4 from the origin, where f32 positions are 1e-3 apart:
+    /// at a step of eight roundings the sample points are off their intended offsets by up
+    /// to 6% of the step, which dividing by the intended offsets turns into a normal off
+    /// by about as much. Solved with the real offsets, both schemes stay within 1e-3.
+    #[test]
+    fn far_from_the_origin_the_rounding_of_positions_does_not_tilt_normals() {
+        struct Ball(Vec3);
+        impl DistanceField for Ball {
+            fn distance(&self, p: Vec3) -> f32 {
+                (p - self.0).length() - 50.0
+            }
+            fn lipschitz(&self) -> f32 {
+                1.0
+            }
+        }
+        // Coordinates in three binades, so that each axis rounds its offsets differently.
+        let center = Vec3::new(1e4, 6e3, 3e3);
+        let ball = Ball(center);
+        // Eight roundings of the largest coordinate: small enough that the rounding of the
+        // sample points matters, large enough that the field's own rounding does not.
+        let h = 8.0 * f32::EPSILON * 1e4;
+        for i in 0..200 {
+            let a = i as f32 * 0.618_034 * std::f32::consts::TAU;
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / 200.0;
+            let r = (1.0 - z * z).sqrt();
+            let n = Vec3::new(r * a.cos(), r * a.sin(), z);
+            let p = center + n * 50.0;
+            for (name, got) in [
+                ("tetrahedron", normal(&ball, p, h)),
+                ("central", normal_central(&ball, p, h)),
+            ] {
+                let exact = (p - center).normalize();
+                let angle = got.dot(exact).clamp(-1.0, 1.0).acos();
+                assert!(angle < 1e-3, "{name} at {p}: off by {angle}");
             }
         }
     }

@@ -67,6 +67,25 @@ fn inverse_rotation(q: Quat) -> Mat3A {
     Mat3A::from_quat(q / n).transpose()
 }
 
+impl PreparedSdf {
+    /// The magnitude of the numbers the shape is evaluated with at `p`, as a world length:
+    /// the field's rounding error at `p` is a few `f32::EPSILON` of it. For a primitive
+    /// that is only moved it is the largest coordinate of `p` in the primitive's frame
+    /// (about its size, wherever it stands, since `p - offset` is exact near it); a turned
+    /// or scaled one mixes or multiplies the coordinates of `p` first, which rounds them
+    /// at `|p|`.
+    #[inline]
+    pub fn evaluation_scale(&self, p: Vec3) -> f32 {
+        let local = self.to_local.transform_point3a(Vec3A::from(p));
+        let own = self.factor * local.abs().max_element();
+        if self.to_local.matrix3 == Mat3A::IDENTITY {
+            own
+        } else {
+            own.max(p.abs().max_element())
+        }
+    }
+}
+
 impl DistanceField for PreparedSdf {
     #[inline]
     fn distance(&self, p: Vec3) -> f32 {

@@ -1,7 +1,24 @@
 //! Sphere tracing (Hart 1996): march along a ray by steps no field value can overshoot,
 //! and its over-relaxed variant (Keinert et al. 2014), which steps further and checks.
 
+use glam::Vec3;
+
 use crate::{DistanceField, Ray};
+
+/// The hit threshold is never below this many [`position_rounding`]s of the ray's origin,
+/// nor below this many `f32::EPSILON` of `t`: closer than that, the field is evaluated at
+/// positions that f32 cannot tell apart, and a smaller threshold would only make the
+/// tracer crawl.
+pub const HIT_ULPS: f32 = 4.0;
+
+/// The rounding of f32 positions near `p`: `f32::EPSILON` times its largest coordinate,
+/// which is at least one unit in the last place of every coordinate, so two points closer
+/// than this may round to the same one. Never zero (at the origin it is the smallest
+/// normal f32), so that thresholds built on it stay positive.
+#[inline]
+pub fn position_rounding(p: Vec3) -> f32 {
+    (f32::EPSILON * p.abs().max_element()).max(f32::MIN_POSITIVE)
+}
 
 /// Sphere tracing parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,6 +34,22 @@ pub struct TraceParams {
     /// Relative hit threshold: the pixel footprint (an angle) for camera rays, so that far
     /// surfaces are not refined below what a pixel can resolve.
     pub eps_rel: f32,
+}
+
+impl TraceParams {
+    /// These parameters for a ray starting at `origin`: the absolute hit threshold raised to
+    /// [`HIT_ULPS`] roundings of the origin, and the relative one to [`HIT_ULPS`] ulps of
+    /// `t` (a point at `t` is at most `|origin| + t` from the origin). Everything else, and
+    /// any larger threshold the caller chose, is kept. The threshold then follows what f32
+    /// can resolve *along this ray*, whatever else the scene holds.
+    #[inline]
+    pub fn resolving(self, origin: Vec3) -> TraceParams {
+        TraceParams {
+            eps_abs: self.eps_abs.max(HIT_ULPS * position_rounding(origin)),
+            eps_rel: self.eps_rel.max(HIT_ULPS * f32::EPSILON),
+            ..self
+        }
+    }
 }
 
 impl Default for TraceParams {
@@ -441,6 +474,27 @@ mod tests {
             OVER_RELAXATION,
         );
         assert_eq!(out.hit_t(), Some(10.0), "{out:?}");
+    }
+
+    #[test]
+    fn thresholds_resolve_to_the_origins_rounding() {
+        let p = TraceParams {
+            eps_abs: 0.0,
+            eps_rel: 0.0,
+            ..TraceParams::default()
+        };
+        // At the origin the floor is the smallest normal f32, never zero.
+        assert_eq!(
+            p.resolving(Vec3::ZERO).eps_abs,
+            HIT_ULPS * f32::MIN_POSITIVE
+        );
+        // It grows with the largest coordinate only, and keeps a larger chosen threshold.
+        let far = p.resolving(Vec3::new(-1e4, 3.0, 2.0));
+        assert_eq!(far.eps_abs, HIT_ULPS * f32::EPSILON * 1e4);
+        assert_eq!(far.eps_rel, HIT_ULPS * f32::EPSILON);
+        let chosen = TraceParams::default();
+        assert_eq!(chosen.resolving(Vec3::ONE).eps_abs, chosen.eps_abs);
+        assert_eq!(chosen.resolving(Vec3::ONE).eps_rel, chosen.eps_rel);
     }
 
     #[test]
