@@ -34,13 +34,15 @@ fn camera_rays(scene: &Scene) -> Vec<Ray> {
         .collect()
 }
 
-/// Camera-ray parameters as the integrator derives them for a 256x256 render.
+/// Camera-ray parameters as the integrator derives them for a 256x256 render (the
+/// integrator raises the absolute threshold per ray to the rounding at its origin, which
+/// `intersect` does here too).
 fn camera_params(scene: &Scene, settings: &RenderSettings) -> TraceParams {
     TraceParams {
         t_min: 0.0,
         t_max: 100.0 * scene.scale(),
         max_steps: settings.max_steps,
-        eps_abs: settings.epsilon_abs * scene.scale(),
+        eps_abs: 0.0,
         eps_rel: settings.pixel_epsilon * scene.camera.pixel_angle(256),
     }
 }

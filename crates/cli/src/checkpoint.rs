@@ -37,7 +37,7 @@ pub fn settings_fingerprint(s: &RenderSettings, naive: bool) -> String {
     };
     format!(
         "width={} height={} strategy={} sampler={} seed={} max_depth={} roulette_depth={} max_steps={} \
-         pixel_epsilon={} epsilon={} epsilon_abs={} naive={naive}{spp}",
+         pixel_epsilon={} epsilon={} naive={naive}{spp}",
         s.width,
         s.height,
         s.strategy,
@@ -48,7 +48,6 @@ pub fn settings_fingerprint(s: &RenderSettings, naive: bool) -> String {
         s.max_steps,
         s.pixel_epsilon,
         s.epsilon_rel,
-        s.epsilon_abs,
     )
 }
 

@@ -4,7 +4,8 @@ use glam::Vec3;
 use lueur_materials::{HemisphereSampling, Material};
 use lueur_sampling::{Sampler, power_heuristic};
 use lueur_sdf_math::{
-    DistanceField, FALLBACK_NORMAL, Ray, TraceParams, gradient, gradient_central,
+    DistanceField, FALLBACK_NORMAL, PreparedSdf, Ray, TraceParams, gradient, gradient_central,
+    position_rounding,
 };
 
 use crate::scene::{Hit, Light, Marching, Scene, TraceCounters};
@@ -39,13 +40,14 @@ impl RayCounters {
     }
 }
 
-/// Marching parameters for one render, derived from the scene's scale.
+/// Marching parameters for one render. Only the far limit follows the scene's size; the
+/// hit thresholds are the pixel cone (camera rays) or a fraction of the distance travelled
+/// (secondary rays), raised per ray to what f32 resolves at its origin
+/// ([`TraceParams::resolving`], in `Scene`), and never depend on what else the scene holds.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct March {
     pub camera: TraceParams,
     pub secondary: TraceParams,
-    /// Smallest offset of a ray's origin above the surface it leaves.
-    pub spawn_floor: f32,
     /// Whether the (pinhole) camera sits inside a solid: every camera ray
     /// then starts inside. Decided once per render, not per ray.
     pub camera_inside: bool,
@@ -56,31 +58,73 @@ pub(crate) struct March {
 
 impl March {
     pub fn new(scene: &Scene, settings: &RenderSettings) -> March {
-        let scale = scene.scale();
-        let eps_abs = settings.epsilon_abs * scale;
-        let far = 100.0 * scale;
         let camera = TraceParams {
             t_min: 0.0,
-            t_max: far,
+            t_max: FAR_LIMIT * scene.scale(),
             max_steps: settings.max_steps,
-            eps_abs,
+            eps_abs: 0.0,
             eps_rel: settings.pixel_epsilon * scene.camera.pixel_angle(settings.height),
         };
         let secondary = TraceParams {
             eps_rel: settings.epsilon_rel,
             ..camera
         };
-        // Rays leave surfaces at least this far above them: far above the
-        // secondary hit threshold at their start (eps_abs), and above the
-        // f32 rounding of positions this far from the origin.
-        let spawn_floor = (64.0 * eps_abs).max(8.0 * f32::EPSILON * scene.extent());
         March {
             camera,
             secondary,
-            spawn_floor,
             camera_inside: scene.distance(scene.camera.position()) < 0.0,
             central_normals: scene.marching == Marching::Naive,
         }
+    }
+}
+
+/// Rays travel at most this many scene radii ([`Scene::scale`]): the one length that
+/// follows the whole scene, since where a ray gives up looking decides nothing about where
+/// it starts or stops on a surface.
+const FAR_LIMIT: f32 = 100.0;
+
+/// A ray leaves a surface at least this many roundings above it: of the hit point's
+/// position ([`position_rounding`]) and of the hit object's own evaluation there
+/// ([`PreparedSdf::evaluation_scale`]). Four times [`lueur_sdf_math::HIT_ULPS`], so the
+/// new ray's first sample is clear of its own hit threshold, with the point's rounding
+/// (half a unit) and the field's (a few) to spare.
+const SPAWN_ROUNDINGS: f32 = 16.0;
+
+/// The finite-difference step of normals and of the Newton step is at least this many
+/// roundings of the object's evaluation: the field's rounding error over the step is then
+/// below 1e-3 of the gradient (the rounding of positions is removed by the normal
+/// estimators themselves, which use the real offsets of their samples).
+const GRADIENT_ROUNDINGS: f32 = 1024.0;
+
+/// What limits the precision of one hit: the tracer's shell there and f32 rounding.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HitPrecision {
+    /// The hit threshold in force where the tracer stopped: it stopped somewhere in a
+    /// shell this thick.
+    pub shell: f32,
+    /// The rounding of the hit point's position.
+    pub position: f32,
+    /// The rounding of the hit object's field at the hit point.
+    pub evaluation: f32,
+    /// Whether the ray reached the surface from inside the solid (it was
+    /// marched by the negated field).
+    pub from_inside: bool,
+}
+
+impl HitPrecision {
+    /// The precision of a hit on `object` at `hit` within a shell `shell` thick.
+    pub fn at(object: &PreparedSdf, hit: Vec3, shell: f32, from_inside: bool) -> HitPrecision {
+        HitPrecision {
+            shell,
+            position: position_rounding(hit),
+            evaluation: f32::EPSILON * object.evaluation_scale(hit),
+            from_inside,
+        }
+    }
+
+    /// The smallest offset of a ray's origin above the surface.
+    fn spawn_floor(&self) -> f32 {
+        SPAWN_ROUNDINGS * self.position.max(self.evaluation)
     }
 }
 
@@ -125,10 +169,11 @@ impl SurfacePoint {
         sdf: &F,
         hit: Vec3,
         wo: Vec3,
-        epsilon: f32,
+        precision: HitPrecision,
         march: &March,
     ) -> SurfacePoint {
-        let spawn_floor = march.spawn_floor;
+        let spawn_floor = precision.spawn_floor();
+        let epsilon = precision.shell;
         let reach = 4.0 * epsilon.max(spawn_floor);
         // The difference step is an eighth of the hit shell: finite
         // differences blur a crease (the Death Star's rim) over about h,
@@ -136,16 +181,22 @@ impl SurfacePoint {
         // blur biased whole rows of rim pixels, differently for the
         // tetrahedron and for central differences (measured: z = 7 between
         // the two at 32x32, 256 spp). Smooth surfaces do not care: their
-        // gradient is exact at any h.
-        let h = (epsilon * 0.125).max(spawn_floor);
+        // gradient is exact at any h. Below, the field's own rounding would
+        // show in the normal.
+        let h = (epsilon * 0.125)
+            .max(GRADIENT_ROUNDINGS * precision.evaluation)
+            .max(2.0 * precision.position);
         // Newton along the ray: f(hit + s dir) = 0 with the slope of f along
-        // the ray by a forward difference. Taken only where the ray meets
-        // the surface at more than ~75 degrees from grazing (the slope is at
-        // least a quarter of a unit gradient) and the step stays within a
-        // few shells; elsewhere the normal projection below does the work.
+        // the ray by a forward difference (over the offset actually taken,
+        // which rounding makes differ from h far from the origin). Taken only
+        // where the ray meets the surface at more than ~75 degrees from
+        // grazing (the slope is at least a quarter of a unit gradient) and
+        // the step stays within a few shells; elsewhere the normal projection
+        // below does the work.
         let dir = -wo;
         let f_hit = sdf.distance(hit);
-        let slope = (sdf.distance(hit + dir * h) - f_hit) / h;
+        let ahead = hit + dir * h;
+        let slope = (sdf.distance(ahead) - f_hit) / (ahead - hit).dot(dir);
         let along = -f_hit / slope;
         let on_ray = slope.abs() >= 0.25 && along.is_finite() && along.abs() <= reach;
         let start = if on_ray { hit + dir * along } else { hit };
@@ -173,8 +224,16 @@ impl SurfacePoint {
         } else {
             (start, (f_start / g.max(1e-3)).abs())
         };
-        let inside = n_geo.dot(wo) < 0.0;
+        // A ray marched inside the solid meets it from inside even where it
+        // grazes the wall and the normal's sign is noise.
+        let inside = precision.from_inside || n_geo.dot(wo) < 0.0;
         let n = if inside { -n_geo } else { n_geo };
+        // The roundings where the ray will start: at `p`, which the Newton step
+        // may have moved far from where the tracer stopped (along a ray that
+        // meets the surface at 20 degrees, four times the shell).
+        let moved = f32::EPSILON * (p - hit).abs().max_element();
+        let spawn_floor = spawn_floor
+            .max(SPAWN_ROUNDINGS * position_rounding(p).max(precision.evaluation + moved));
         let offset = spawn_floor.max(if residual.is_finite() {
             4.0 * residual
         } else {
@@ -268,12 +327,9 @@ pub(crate) fn radiance(
         } else {
             &mut counters.bounce
         };
-        let hit = if depth == 0 && started_inside || previous.in_solid {
-            scene.intersect_maybe_inside(&ray, &params, kind)
-        } else {
-            scene.intersect(&ray, &params, kind)
-        };
-        let (t, object, epsilon) = match hit {
+        let maybe_inside = depth == 0 && started_inside || previous.in_solid;
+        let hit = scene.intersect_leaving(&ray, previous.p, &params, kind, maybe_inside);
+        let (t, object, epsilon, marched_inside) = match hit {
             None => {
                 if let Some(sky) = scene.sky {
                     let w = if previous.full_weight {
@@ -291,7 +347,12 @@ pub(crate) fn radiance(
                 break;
             }
             Some(Hit::Light { t, light }) => {
-                let le = scene.emitted(light, &ray, t);
+                // Light hits are measured from the last vertex, not from the lifted origin.
+                let from = Ray {
+                    origin: previous.p,
+                    dir: ray.dir,
+                };
+                let le = scene.emitted(light, &from, t);
                 if le != Vec3::ZERO {
                     let w = if previous.full_weight {
                         1.0
@@ -303,20 +364,25 @@ pub(crate) fn radiance(
                 }
                 break;
             }
-            Some(Hit::Surface { t, object, epsilon }) => (t, object, epsilon),
+            Some(Hit::Surface {
+                t,
+                object,
+                epsilon,
+                inside,
+            }) => (t, object, epsilon, inside),
         };
         if depth >= settings.max_depth {
             break;
         }
 
         let wo = -ray.dir;
+        let hit = ray.at(t);
+        let precision = HitPrecision::at(scene.prepared(object), hit, epsilon, marched_inside);
         let surface = match scene.marching {
             Marching::Naive => {
-                SurfacePoint::new(&scene.objects[object].sdf, ray.at(t), wo, epsilon, &march)
+                SurfacePoint::new(&scene.objects[object].sdf, hit, wo, precision, &march)
             }
-            Marching::Fast => {
-                SurfacePoint::new(scene.prepared(object), ray.at(t), wo, epsilon, &march)
-            }
+            Marching::Fast => SurfacePoint::new(scene.prepared(object), hit, wo, precision, &march),
         };
         let (p, n, origin) = (surface.p, surface.n, surface.origin);
         let material = scene.materials[scene.objects[object].material];
@@ -517,15 +583,15 @@ fn next_event(
 mod tests {
     use super::*;
     use crate::scene::ray_sphere;
+    use lueur_materials::Material;
     use lueur_sdf_math::Sdf;
 
-    /// A march with the given hit shell and a tiny spawn offset.
+    /// A march with the default thresholds.
     fn march(central_normals: bool) -> March {
         let params = TraceParams::default();
         March {
             camera: params,
             secondary: params,
-            spawn_floor: 1e-7,
             camera_inside: false,
             central_normals,
         }
@@ -546,7 +612,7 @@ mod tests {
 
     /// Wherever in the shell the tracer stopped, the shading point is the
     /// ray's own intersection and the normal the one there. Projecting along
-    /// the normal instead (the old way) is off by up to `epsilon tan(theta)`
+    /// the normal instead is off by up to `epsilon tan(theta)`
     /// sideways: 1.7 shells at 60 degrees, which this test would catch.
     #[test]
     fn shading_point_is_on_the_ray_wherever_the_tracer_stopped() {
@@ -562,8 +628,9 @@ mod tests {
                 let n_true = x_true / radius;
                 for depth in [0.0f32, 0.3, 0.6, 0.95] {
                     let t_hit = t_at_level(&sdf, &ray, depth * epsilon, 0.0, t_true);
-                    let s =
-                        SurfacePoint::new(&sdf, ray.at(t_hit), -ray.dir, epsilon, &march(central));
+                    let hit = ray.at(t_hit);
+                    let precision = HitPrecision::at(&PreparedSdf::new(&sdf), hit, epsilon, false);
+                    let s = SurfacePoint::new(&sdf, hit, -ray.dir, precision, &march(central));
                     let off = (s.p - x_true).length();
                     assert!(
                         off < 0.1 * epsilon,
@@ -576,6 +643,86 @@ mod tests {
                     );
                     assert!((s.origin - s.p).dot(s.n) > 0.0);
                 }
+            }
+        }
+    }
+
+    /// The shape a property test puts in a scene: `size` is its largest half-extent.
+    fn shape(kind: u8, size: f32) -> Sdf {
+        match kind {
+            0 => Sdf::sphere(size),
+            1 => Sdf::cuboid(Vec3::new(1.0, 0.4, 0.7) * size),
+            _ => Sdf::torus(0.7 * size, 0.3 * size),
+        }
+    }
+
+    /// What else a scene may hold besides the object hit: nothing, a floor 1e4 wide under
+    /// it, an unbounded plane far below, or a large sphere 1e4 away.
+    fn rest_of_scene(kind: u8, below: f32) -> Vec<Sdf> {
+        match kind {
+            0 => vec![],
+            1 => vec![Sdf::cuboid(Vec3::new(5e3, 0.5, 5e3)).translate(Vec3::Y * (below - 0.5))],
+            2 => vec![Sdf::plane(Vec3::Y, below - 100.0)],
+            _ => vec![Sdf::sphere(100.0).translate(Vec3::new(1e4, 0.0, 0.0))],
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(512))]
+
+        /// At any hit, the ray leaving the surface starts no higher above it than a small
+        /// multiple of the rounding at the hit (of its position and of the object's own
+        /// evaluation) plus the tracer's shell there, whatever else the scene holds: a
+        /// floor 1e4 wide, an unbounded plane, a sphere 1e4 away. For objects from 1e-3 to
+        /// 1e2 across, up to 1e3 from the origin, that f32 resolves: at least 1000
+        /// roundings of their position across their thinnest part (a torus of 1e-3 at 700
+        /// from the origin has a tube four roundings thick; nothing there is resolved).
+        #[test]
+        fn spawn_offsets_follow_the_hit_not_the_scene(
+            kind in 0u8..3,
+            size_exp in -3.0f32..2.0,
+            cx in -1e3f32..1e3, cy in -1e3f32..1e3, cz in -1e3f32..1e3,
+            theta in 0.0f32..std::f32::consts::PI, phi in 0.0f32..std::f32::consts::TAU,
+            aim in -0.5f32..0.5,
+            rest in 0u8..4,
+        ) {
+            let size = 10f32.powf(size_exp);
+            let center = Vec3::new(cx, cy, cz);
+            proptest::prop_assume!(0.3 * size >= 1e3 * position_rounding(center));
+            let object = shape(kind, size).translate(center);
+            let dir = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            let side = dir.any_orthonormal_vector();
+            let origin = center - dir * 5.0 * size + side * aim * size;
+            let ray = Ray::new(origin, dir);
+            let camera = crate::Camera::new(origin, center, dir.any_orthonormal_vector(), 40.0)
+                .unwrap();
+            let mut offsets = Vec::new();
+            for others in [rest_of_scene(0, 0.0), rest_of_scene(rest, cy - 2.0 * size)] {
+                let objects = std::iter::once(object.clone())
+                    .chain(others)
+                    .map(|sdf| crate::Object { sdf, material: 0 })
+                    .collect();
+                let white = Material::Lambertian { albedo: Vec3::ONE };
+                let scene = Scene::new(objects, vec![white], vec![], None, camera).unwrap();
+                let march = March::new(&scene, &RenderSettings::default());
+                let mut counters = crate::TraceCounters::default();
+                let Some(Hit::Surface { t, object: 0, epsilon, .. }) =
+                    scene.intersect(&ray, &march.secondary, &mut counters)
+                else {
+                    continue;
+                };
+                let hit = ray.at(t);
+                let precision = HitPrecision::at(scene.prepared(0), hit, epsilon, false);
+                let s = SurfacePoint::new(scene.prepared(0), hit, -ray.dir, precision, &march);
+                let offset = (s.origin - s.p).length();
+                let rounding = position_rounding(s.p) + f32::EPSILON * size;
+                let bound = 32.0 * rounding + 2.0 * epsilon;
+                proptest::prop_assert!(
+                    offset <= bound,
+                    "offset {offset} above {bound} (rounding {rounding}, shell {epsilon})"
+                );
+                proptest::prop_assert!(offset >= 8.0 * position_rounding(s.p));
+                offsets.push(offset);
             }
         }
     }

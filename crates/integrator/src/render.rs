@@ -52,8 +52,6 @@ pub struct RenderSettings {
     /// Secondary rays hit when closer than this fraction of the distance
     /// travelled.
     pub epsilon_rel: f32,
-    /// Floor of every hit epsilon, as a fraction of the scene's scale.
-    pub epsilon_abs: f32,
 }
 
 impl Default for RenderSettings {
@@ -76,7 +74,6 @@ impl Default for RenderSettings {
             // none at a sixteenth: docs/PEERS.md), for no measurable time.
             pixel_epsilon: 0.0625,
             epsilon_rel: 1e-4,
-            epsilon_abs: 1e-6,
         }
     }
 }
@@ -118,7 +115,6 @@ impl RenderSettings {
                 "pixel_epsilon must be positive and finite",
             ),
             (self.epsilon_rel, "epsilon_rel must be positive and finite"),
-            (self.epsilon_abs, "epsilon_abs must be positive and finite"),
         ] {
             if !(v > 0.0 && v.is_finite()) {
                 return Err(RenderError::InvalidSetting(what));
