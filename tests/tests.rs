@@ -26,3 +26,8 @@ mod degenerate;
 
 // The fast marching against the naive reference: the same images.
 mod marching;
+
+// A small light's answer against its closed form, whatever the size of the floor under it,
+// the scene's scale or its distance from the origin; a millimetre sphere's shadow on a
+// ten-kilometre floor.
+mod scale_free;
