@@ -2,11 +2,14 @@
 //! crates: it reads scene files, draws the progress bar and writes images;
 //! every decision about light lives in `lueur-integrator`.
 
+mod bar;
 mod checkpoint;
+mod interrupt;
 mod output;
 mod points;
 mod progressive;
 mod stats;
+mod validate;
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -14,10 +17,11 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use indicatif::{ProgressBar, ProgressStyle};
 use lueur_integrator::{Film, Marching, RenderOutput, RenderSettings, Strategy};
 use lueur_sampling::SamplerKind;
 use lueur_scene::{SceneFileError, parse_scene};
+
+use interrupt::Interrupted;
 
 /// Exit status for input the user must fix (scene files, flags), as clap
 /// does for usage errors.
@@ -97,11 +101,14 @@ struct RenderArgs {
     #[arg(long)]
     height: Option<u32>,
     /// Worker threads (default: one per core). The image does not depend on it.
-    #[arg(long)]
+    #[arg(long, short = 't')]
     threads: Option<usize>,
     /// Exposure in stops applied before PNG encoding (EXR stays linear).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     exposure: f32,
+    /// Print nothing but errors and warnings: no progress bar, no summary.
+    #[arg(long, short = 'q')]
+    quiet: bool,
     /// Print statistics after the render: rays, steps per ray, hit shares.
     #[arg(long)]
     stats: bool,
@@ -162,52 +169,6 @@ fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
     })
 }
 
-/// The render was stopped by a signal; what was complete has been written.
-#[derive(Debug)]
-struct Interrupted {
-    /// Samples per pixel that every pixel has.
-    spp: u32,
-    /// The interrupted pass's end and the share of pixels that reached it.
-    unfinished: Option<(u32, f64)>,
-    /// The checkpoint, which holds the last complete pass.
-    checkpoint: Option<PathBuf>,
-}
-
-impl std::fmt::Display for Interrupted {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        if self.spp == 0 {
-            return write!(
-                f,
-                "interrupted before the first pass completed; nothing written"
-            );
-        }
-        write!(
-            f,
-            "interrupted: wrote the {} spp completed before the signal",
-            self.spp
-        )?;
-        if let Some((end, share)) = self.unfinished {
-            write!(
-                f,
-                ", and {end} spp in the {:.0}% of the pixels whose tiles finished the pass in \
-                 progress",
-                100.0 * share
-            )?;
-        }
-        if let Some(path) = &self.checkpoint {
-            write!(
-                f,
-                "; {} holds the {} spp (resume from it)",
-                path.display(),
-                self.spp
-            )?;
-        }
-        Ok(())
-    }
-}
-
-impl std::error::Error for Interrupted {}
-
 /// `Some(v)` if `v` is positive and finite, a usage error otherwise.
 fn positive(v: Option<f64>, flag: &str) -> Result<Option<f64>> {
     match v {
@@ -247,10 +208,11 @@ fn main() -> ExitCode {
                 }
                 return ExitCode::from(EXIT_BAD_INPUT);
             }
-            eprintln!("error: {e:#}");
-            if e.downcast_ref::<Interrupted>().is_some() {
+            if let Some(interrupted) = e.downcast_ref::<Interrupted>() {
+                eprintln!("{interrupted}");
                 return ExitCode::from(progressive::EXIT_INTERRUPTED);
             }
+            eprintln!("error: {}", validate::error_chain(&e));
             if e.downcast_ref::<BadInput>().is_some() {
                 ExitCode::from(EXIT_BAD_INPUT)
             } else {
@@ -296,9 +258,17 @@ fn run_render(args: RenderArgs) -> Result<()> {
     };
     let format = out
         .as_deref()
-        .map(output::Format::from_path)
-        .transpose()
-        .map_err(|e| BadInput(e.to_string()))?;
+        .map(|p| validate::image_output("--out", p))
+        .transpose()?;
+    if let Some(path) = &args.checkpoint {
+        validate::checkpoint_output("--checkpoint", path)?;
+        if let Some(out) = &out {
+            validate::distinct(("--out", out), ("--checkpoint", path))?;
+        }
+    }
+    if let Some(path) = &args.resume {
+        validate::input("--resume", path)?;
+    }
 
     let limits = progressive::Limits {
         time: positive(args.time, "--time")?,
@@ -307,14 +277,6 @@ fn run_render(args: RenderArgs) -> Result<()> {
     progressive::install_signal_handler()?;
 
     let pixels = u64::from(settings.width) * u64::from(settings.height);
-    let bar = ProgressBar::new(pixels * u64::from(range.end - range.start));
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {wide_bar} {percent}% ETA {eta}",
-        )
-        .expect("the template is valid"),
-    );
-    let progress = |n: u64| bar.inc(n);
     let fingerprint = checkpoint::settings_fingerprint(&settings, args.naive);
     let film = match &args.resume {
         Some(path) => {
@@ -339,7 +301,13 @@ fn run_render(args: RenderArgs) -> Result<()> {
         Some(_) => film,
         None => film.sealed_at(range.end),
     };
-    bar.inc(pixels * u64::from(film.spp().min(range.end - range.start)));
+    let bar = bar::Bar::new(
+        pixels * u64::from(range.end - range.start),
+        pixels * u64::from(film.spp().min(range.end - range.start)),
+        limits.time,
+        args.quiet,
+    );
+    let progress = |n: u64| bar.add(n);
     let mut after_pass = |film: &Film| match &args.checkpoint {
         Some(path) => checkpoint::save(path, film, &text, &fingerprint)
             .with_context(|| format!("cannot write checkpoint {}", path.display())),
@@ -366,7 +334,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
             .install(run),
         None => run(),
     }?;
-    bar.finish_and_clear();
+    bar.finish();
     let output: RenderOutput = output;
     let interrupted = || Interrupted {
         spp: output.film.spp(),
@@ -374,7 +342,9 @@ fn run_render(args: RenderArgs) -> Result<()> {
             .film
             .unfinished_pass()
             .map(|(samples, share)| (samples.end - output.film.samples().start, share)),
+        out: out.clone().filter(|_| output.film.spp() > 0),
         checkpoint: args.checkpoint.clone(),
+        scene: args.scene.clone(),
     };
     if output.film.spp() == 0 {
         // Interrupted during the first pass: a partly black image is of no
@@ -402,16 +372,21 @@ fn run_render(args: RenderArgs) -> Result<()> {
         None => samples,
     };
     let destination = out.as_ref().or(args.checkpoint.as_ref());
-    eprintln!(
+    let say = |text: String| {
+        if !args.quiet {
+            eprintln!("{text}");
+        }
+    };
+    say(format!(
         "rendered {}x{} at {samples} ({}, {}) in {:.2} s, {:.2} M samples/s -> {}",
-        settings.width,
-        settings.height,
+        output.film.width(),
+        output.film.height(),
         settings.strategy,
         settings.sampler.name(),
         secs,
         stats.samples as f64 / secs.max(1e-9) / 1e6,
         destination.map_or_else(String::new, |p| p.display().to_string())
-    );
+    ));
     if stats.dropped_samples > 0 {
         eprintln!(
             "warning: {} NaN or infinite samples were dropped",
@@ -423,24 +398,31 @@ fn run_render(args: RenderArgs) -> Result<()> {
     }
     match stop {
         progressive::Stop::Complete => {}
-        progressive::Stop::TimeBudget => eprintln!(
-            "time budget of {} s reached: stopped at {} of {} spp",
-            args.time.unwrap_or_default(),
-            output.film.spp(),
-            range.end - range.start
-        ),
-        progressive::Stop::TargetError(e) => eprintln!(
+        progressive::Stop::TimeBudget => {
+            let budget = args.time.unwrap_or_default();
+            say(format!(
+                "time budget of {budget} s: used {secs:.2} s ({:.0}%), stopped at {} of {} spp",
+                100.0 * secs / budget,
+                output.film.spp(),
+                range.end - range.start
+            ))
+        }
+        progressive::Stop::TargetError(e) => say(format!(
             "target error reached: relative error {e:.4} at {} of {} spp",
             output.film.spp(),
             range.end - range.start
-        ),
+        )),
         progressive::Stop::Interrupted => return Err(interrupted().into()),
     }
     Ok(())
 }
 
 fn run_merge(args: MergeArgs) -> Result<()> {
-    let format = output::Format::from_path(&args.out).map_err(|e| BadInput(e.to_string()))?;
+    let format = validate::image_output("--out", &args.out)?;
+    if let Some(path) = &args.checkpoint {
+        validate::checkpoint_output("--checkpoint", path)?;
+        validate::distinct(("--out", &args.out), ("--checkpoint", path))?;
+    }
     if !args.exposure.is_finite() {
         bail!(BadInput("--exposure must be finite".into()));
     }

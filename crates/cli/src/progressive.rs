@@ -24,12 +24,12 @@ pub const EXIT_INTERRUPTED: u8 = 130;
 pub fn install_signal_handler() -> anyhow::Result<()> {
     ctrlc::set_handler(|| {
         if SIGNALS.fetch_add(1, Ordering::SeqCst) >= 1 {
-            eprintln!("\nsecond interrupt: exiting without writing");
+            crate::bar::message("second interrupt: exiting without writing");
             crate::output::remove_temporaries();
             std::process::exit(i32::from(EXIT_INTERRUPTED));
         }
         CANCEL.store(true, Ordering::SeqCst);
-        eprintln!("\ninterrupt: writing the tiles rendered so far (again to exit now)");
+        crate::bar::message("interrupt: writing the tiles rendered so far (again to exit now)");
     })?;
     Ok(())
 }
