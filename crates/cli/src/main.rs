@@ -4,10 +4,14 @@
 
 mod bar;
 mod checkpoint;
+mod crop;
+mod fingerprint;
 mod interrupt;
+mod merge;
 mod output;
 mod points;
 mod progressive;
+mod resume;
 mod stats;
 mod validate;
 
@@ -17,10 +21,11 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use lueur_integrator::{Film, Marching, RenderOutput, RenderSettings, Strategy};
+use lueur_integrator::{Film, Marching, PixelBounds, RenderOutput, RenderSettings, Strategy};
 use lueur_sampling::SamplerKind;
 use lueur_scene::{SceneFileError, parse_scene};
 
+use fingerprint::Fingerprint;
 use interrupt::Interrupted;
 
 /// Exit status for input the user must fix (scene files, flags), as clap
@@ -66,6 +71,10 @@ struct MergeArgs {
     /// Exposure in stops applied before PNG encoding (EXR stays linear).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     exposure: f32,
+    /// Merge shards that do not hold every sample of the render (missing
+    /// samples at its start or end); refused otherwise, listing them.
+    #[arg(long)]
+    allow_partial: bool,
 }
 
 #[derive(Parser)]
@@ -137,6 +146,24 @@ struct RenderArgs {
     /// where the shard is saved for `lueur merge`; --out is then optional.
     #[arg(long, value_name = "START..END", value_parser = parse_sample_range)]
     sample_range: Option<Range<u32>>,
+    /// Override a scene-file key by its dotted path, as the file would set
+    /// it (repeatable): camera.vfov=30, render.max_steps=64,
+    /// lights[0].radiance=[1,1,1].
+    #[arg(long = "set", short = 'D', value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Render only this part of the image, in fractions of its width and
+    /// height (pbrt-v4's --cropwindow; row 0 at the top); the image written
+    /// is the crop's size, its pixels those of the full render.
+    #[arg(long, num_args = 4, value_names = ["X0", "X1", "Y0", "Y1"], conflicts_with = "pixel_bounds")]
+    crop_window: Option<Vec<f64>>,
+    /// Render only pixels X0..X1 x Y0..Y1 of the image, ends excluded
+    /// (pbrt-v4's --pixelbounds).
+    #[arg(long, num_args = 4, value_names = ["X0", "X1", "Y0", "Y1"])]
+    pixel_bounds: Option<Vec<u32>>,
+    /// Write the output image every SECONDS while rendering (atomically,
+    /// between passes), for a viewer that reloads it.
+    #[arg(long, value_name = "SECONDS")]
+    partial_every: Option<f64>,
 }
 
 fn parse_sample_range(s: &str) -> Result<Range<u32>, String> {
@@ -222,10 +249,17 @@ fn main() -> ExitCode {
     }
 }
 
-fn run_render(args: RenderArgs) -> Result<()> {
+fn run_render(mut args: RenderArgs) -> Result<()> {
     let file = args.scene.display().to_string();
     let text = std::fs::read_to_string(&args.scene)
         .map_err(|e| BadInput(format!("cannot read scene file {file}: {e}")))?;
+    let resumed = match args.resume.clone() {
+        Some(path) => {
+            validate::input("--resume", &path)?;
+            Some(resume::restore(&path, &mut args)?)
+        }
+        None => None,
+    };
     let parsed = parse_scene(&text, &file)?;
     let mut scene = parsed.scene;
     if args.naive {
@@ -266,35 +300,36 @@ fn run_render(args: RenderArgs) -> Result<()> {
             validate::distinct(("--out", out), ("--checkpoint", path))?;
         }
     }
-    if let Some(path) = &args.resume {
-        validate::input("--resume", path)?;
-    }
-
+    let bounds = crop::bounds(
+        args.crop_window.as_deref(),
+        args.pixel_bounds.as_deref(),
+        settings.width,
+        settings.height,
+    )?;
     let limits = progressive::Limits {
         time: positive(args.time, "--time")?,
         target_error: positive(args.target_error, "--target-error")?,
+        pass_seconds: positive(args.partial_every, "--partial-every")?,
     };
     progressive::install_signal_handler()?;
 
-    let pixels = u64::from(settings.width) * u64::from(settings.height);
-    let fingerprint = checkpoint::settings_fingerprint(&settings, args.naive);
-    let film = match &args.resume {
-        Some(path) => {
-            let film = checkpoint::load(path, &text, &fingerprint)
-                .map_err(|e| BadInput(format!("{e:#}")))?;
-            if film.samples().start != range.start {
-                return Err(BadInput(format!(
-                    "{} holds samples {:?}, which do not start at {}",
-                    path.display(),
-                    film.samples(),
-                    range.start
-                ))
-                .into());
-            }
-            film
+    let whole = PixelBounds::whole(settings.width, settings.height);
+    let region = bounds.unwrap_or(whole);
+    let pixels = u64::from(region.width()) * u64::from(region.height());
+    let fingerprint = Fingerprint::of(
+        &settings,
+        args.naive,
+        bounds,
+        args.sample_range.as_ref(),
+        &args.set,
+    );
+    let film = match (&args.resume, &resumed) {
+        (Some(path), Some(resumed)) => {
+            resume::load(path, resumed, &text, &fingerprint, settings.sampler, &range)?
         }
-        None => Film::starting_at(settings.width, settings.height, range.start),
+        _ => Film::starting_at(region.width(), region.height(), range.start),
     };
+    let fingerprint = fingerprint.to_string();
     // Without a checkpoint nobody will extend the film: it can keep one
     // image instead of one per dyadic block (two at 24 spp, three at 100).
     let film = match args.checkpoint {
@@ -318,6 +353,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
         progressive::render(
             &scene,
             &settings,
+            region,
             film,
             end,
             limits,
@@ -429,53 +465,12 @@ fn run_merge(args: MergeArgs) -> Result<()> {
     // Headers first: every refusal comes before any pixel is read, and the
     // shards are then loaded one at a time, in order, each merged into the
     // film and dropped (8 shards of a 4K render never sit in memory at once).
-    let mut shards = Vec::new();
-    let mut first: Option<(PathBuf, String, String)> = None;
-    for path in &args.shards {
-        let header = checkpoint::read_header(path).map_err(|e| BadInput(format!("{e:#}")))?;
-        match &first {
-            None => {
-                first = Some((
-                    path.clone(),
-                    header.scene_text.clone(),
-                    header.fingerprint.clone(),
-                ))
-            }
-            Some((p, scene, _)) if *scene != header.scene_text => bail!(BadInput(format!(
-                "{} and {} are renders of different scene files; cannot merge",
-                p.display(),
-                path.display()
-            ))),
-            Some((p, _, settings)) if *settings != header.fingerprint => {
-                bail!(BadInput(format!(
-                    "{} and {} were rendered with different settings; cannot merge.\n  {}: {settings}\n  {}: {}",
-                    p.display(),
-                    path.display(),
-                    p.display(),
-                    path.display(),
-                    header.fingerprint
-                )))
-            }
-            Some(_) => {}
-        }
-        shards.push((path.clone(), header.samples));
-    }
-    let (_, scene_text, fingerprint) = first.expect("clap requires one shard");
-    // Name the files on either side of a gap or an overlap.
-    shards.sort_by_key(|(_, samples)| samples.start);
-    for pair in shards.windows(2) {
-        let (a, b) = (&pair[0], &pair[1]);
-        if a.1.end != b.1.start {
-            bail!(BadInput(format!(
-                "{} holds samples {:?} and {} holds {:?}: shards must follow each other \
-                 without gap or overlap",
-                a.0.display(),
-                a.1,
-                b.0.display(),
-                b.1
-            )));
-        }
-    }
+    let merge::Shards {
+        shards,
+        scene_text,
+        fingerprint,
+    } = merge::plan(&args.shards, args.allow_partial)?;
+    let fingerprint = fingerprint.to_string();
     let count = shards.len();
     let mut film: Option<Film> = None;
     for (path, _) in &shards {

@@ -73,3 +73,223 @@ fn bad_output_paths_are_refused_before_rendering() {
     }
     assert_eq!(entries(dir.path()), 0, "nothing written, no probe left");
 }
+
+/// Renders the donut at 24x20 with `extra` flags in `dir`, asserting success.
+fn render(dir: &Path, extra: &[&str]) -> Output {
+    let donut = scene("donut-mirrors");
+    let mut args = vec!["render", donut.as_str(), "--width", "24", "--height", "20"];
+    args.extend_from_slice(extra);
+    let o = lueur(&args, dir);
+    assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+    o
+}
+
+fn read(dir: &Path, name: &str) -> Vec<u8> {
+    std::fs::read(dir.join(name)).unwrap()
+}
+
+/// A checkpoint restores size and every setting: a render stopped after
+/// its first pass (a time budget too short for a second) and resumed
+/// with no flag at all ends byte-identical to the direct render.
+#[test]
+fn resume_without_flags_equals_the_direct_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let settings = [
+        "--spp",
+        "12",
+        "--seed",
+        "5",
+        "--strategy",
+        "mixture",
+        "--max-depth",
+        "3",
+    ];
+    render(d, &[&settings[..], &["-o", "whole.exr"]].concat());
+    let o = render(
+        d,
+        &[
+            &settings[..],
+            &["--time", "1e-9", "--checkpoint", "ck.exr", "-o", "cut.exr"],
+        ]
+        .concat(),
+    );
+    assert!(
+        stderr(&o).contains("stopped at 1 of 12 spp"),
+        "{}",
+        stderr(&o)
+    );
+    let donut = scene("donut-mirrors");
+    let o = lueur(
+        &["render", &donut, "--resume", "ck.exr", "-o", "resumed.exr"],
+        d,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(read(d, "resumed.exr") == read(d, "whole.exr"));
+
+    // Flags may repeat the checkpoint's settings, not change them: each
+    // difference is listed by name, the checkpoint's value first.
+    let o = lueur(
+        &[
+            "render", &donut, "--resume", "ck.exr", "--seed", "6", "--width", "30",
+        ],
+        d,
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("\n  width: 24, 30\n  seed: 5, 6"), "{err}");
+    // And a target below what the checkpoint holds is refused.
+    let four = [
+        "--seed",
+        "5",
+        "--spp",
+        "4",
+        "--checkpoint",
+        "four.exr",
+        "-o",
+        "f.exr",
+    ];
+    render(d, &four);
+    let o = lueur(&["render", &donut, "--resume", "four.exr", "--spp", "2"], d);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("already holds 4 spp"), "{}", stderr(&o));
+}
+
+/// Shards covering 0..12 of a 32-spp render are refused, the missing
+/// samples named, unless --allow-partial.
+#[test]
+fn a_partial_merge_is_refused_unless_allowed() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (range, file) in [("0..4", "a.exr"), ("4..12", "b.exr")] {
+        render(
+            d,
+            &["--spp", "32", "--sample-range", range, "--checkpoint", file],
+        );
+    }
+    let o = lueur(&["merge", "a.exr", "b.exr", "-o", "m.png"], d);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("samples 0..12 of the render's 32 spp: missing 12..32"),
+        "{err}"
+    );
+    assert!(!d.join("m.png").exists());
+    let o = lueur(
+        &["merge", "a.exr", "b.exr", "--allow-partial", "-o", "m.png"],
+        d,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(d.join("m.png").exists());
+}
+
+/// The (R, G, B, variance) values of every pixel of an EXR written by
+/// lueur, row-major, with its size.
+fn exr_pixels(path: &Path) -> (usize, usize, Vec<[u32; 6]>) {
+    use exr::prelude::*;
+    let image = read_all_flat_layers_from_file(path).unwrap();
+    let layer = &image.layer_data[0];
+    let (w, h) = (layer.size.0, layer.size.1);
+    let channel = |name: &str| {
+        let c = layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == name)
+            .unwrap();
+        c.sample_data
+            .values_as_f32()
+            .map(f32::to_bits)
+            .collect::<Vec<_>>()
+    };
+    let names = ["R", "G", "B", "variance.R", "variance.G", "variance.B"];
+    let channels: Vec<Vec<u32>> = names.iter().map(|n| channel(n)).collect();
+    let pixels = (0..w * h)
+        .map(|i| std::array::from_fn(|c| channels[c][i]))
+        .collect();
+    (w, h, pixels)
+}
+
+/// A crop is the same pixels as the full render, bit for bit, whether
+/// given as a crop window or as pixel bounds, and rendered at once, as
+/// shards merged, or resumed from a checkpoint.
+#[test]
+fn a_crop_is_bit_identical_to_the_same_pixels_of_the_full_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    render(d, &["--spp", "6", "-o", "full.exr"]);
+    let (fw, _, full) = exr_pixels(&d.join("full.exr"));
+    // pbrt-v4: pixels from ceil(0.2 * 24) = 5 to ceil(0.7 * 24) = 17, rows
+    // from ceil(0.1 * 20) = 2 to ceil(0.6 * 20) = 12.
+    render(
+        d,
+        &[
+            "--spp",
+            "6",
+            "--crop-window",
+            "0.2",
+            "0.7",
+            "0.1",
+            "0.6",
+            "-o",
+            "window.exr",
+        ],
+    );
+    render(
+        d,
+        &[
+            "--spp",
+            "6",
+            "--pixel-bounds",
+            "5",
+            "17",
+            "2",
+            "12",
+            "-o",
+            "bounds.exr",
+        ],
+    );
+    let crop = ["--pixel-bounds", "5", "17", "2", "12"];
+    for (range, file) in [("0..2", "s0.exr"), ("2..6", "s1.exr")] {
+        let shard = ["--spp", "6", "--sample-range", range, "--checkpoint", file];
+        render(d, &[&crop[..], &shard].concat());
+    }
+    let o = lueur(&["merge", "s1.exr", "s0.exr", "-o", "merged.exr"], d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    render(
+        d,
+        &[
+            &crop[..],
+            &["--spp", "3", "--checkpoint", "c3.exr", "-o", "c3.png"],
+        ]
+        .concat(),
+    );
+    let donut = scene("donut-mirrors");
+    let o = lueur(
+        &[
+            "render",
+            &donut,
+            "--resume",
+            "c3.exr",
+            "--spp",
+            "6",
+            "-o",
+            "resumed.exr",
+        ],
+        d,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    for name in ["window.exr", "bounds.exr", "merged.exr", "resumed.exr"] {
+        let (w, h, pixels) = exr_pixels(&d.join(name));
+        assert_eq!((w, h), (12, 10), "{name}: the crop's size");
+        for y in 0..h {
+            for x in 0..w {
+                assert_eq!(
+                    pixels[y * w + x],
+                    full[(y + 2) * fw + x + 5],
+                    "{name}: pixel ({x}, {y}) of the crop"
+                );
+            }
+        }
+    }
+}
