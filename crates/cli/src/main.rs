@@ -23,7 +23,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use lueur_integrator::{Film, Marching, PixelBounds, RenderOutput, RenderSettings, Strategy};
 use lueur_sampling::SamplerKind;
-use lueur_scene::{SceneFileError, parse_scene};
+use lueur_scene::{SceneFileError, parse_scene_with};
 
 use fingerprint::Fingerprint;
 use interrupt::Interrupted;
@@ -260,7 +260,8 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         }
         None => None,
     };
-    let parsed = parse_scene(&text, &file)?;
+    let overrides: Vec<&str> = args.set.iter().map(String::as_str).collect();
+    let parsed = parse_scene_with(&text, &file, &overrides)?;
     let mut scene = parsed.scene;
     if args.naive {
         scene.marching = Marching::Naive;

@@ -293,3 +293,68 @@ fn a_crop_is_bit_identical_to_the_same_pixels_of_the_full_render() {
         }
     }
 }
+
+/// `--set` reaches the scene (the image changes, and is the same as the
+/// file edited by hand), and a bad key is refused naming it, exit 2.
+#[test]
+fn set_overrides_a_scene_key_and_refuses_a_bad_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    render(d, &["--spp", "2", "-o", "plain.exr"]);
+    render(
+        d,
+        &["--spp", "2", "--set", "camera.vfov=25", "-o", "set.exr"],
+    );
+    assert!(
+        read(d, "plain.exr") != read(d, "set.exr"),
+        "the override changes the image"
+    );
+    let text = std::fs::read_to_string(scene("donut-mirrors")).unwrap();
+    assert!(text.contains("vfov = "), "the scene sets vfov");
+    let edited: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("vfov") {
+                "vfov = 25".to_owned()
+            } else {
+                l.to_owned()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(d.join("edited.toml"), edited).unwrap();
+    let o = lueur(
+        &[
+            "render",
+            "edited.toml",
+            "--width",
+            "24",
+            "--height",
+            "20",
+            "--spp",
+            "2",
+            "-o",
+            "edited.exr",
+        ],
+        d,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        read(d, "edited.exr") == read(d, "set.exr"),
+        "same as editing the file"
+    );
+
+    let donut = scene("donut-mirrors");
+    let o = lueur(
+        &["render", &donut, "--set", "camera.vfvo=25", "-o", "bad.png"],
+        d,
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("`camera.vfvo`") && err.contains("--set"),
+        "{err}"
+    );
+    assert!(err.contains("did you mean `vfov`?"), "{err}");
+    assert!(!d.join("bad.png").exists());
+}
