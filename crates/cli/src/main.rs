@@ -9,6 +9,7 @@ mod fingerprint;
 mod interrupt;
 mod merge;
 mod output;
+mod partial;
 mod points;
 mod progressive;
 mod resume;
@@ -312,6 +313,11 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         target_error: positive(args.target_error, "--target-error")?,
         pass_seconds: positive(args.partial_every, "--partial-every")?,
     };
+    if limits.pass_seconds.is_some() && out.is_none() {
+        bail!(BadInput(
+            "--partial-every writes the output image: give it with --out".into()
+        ));
+    }
     progressive::install_signal_handler()?;
 
     let whole = PixelBounds::whole(settings.width, settings.height);
@@ -344,10 +350,21 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         args.quiet,
     );
     let progress = |n: u64| bar.add(n);
-    let mut after_pass = |film: &Film| match &args.checkpoint {
-        Some(path) => checkpoint::save(path, film, &text, &fingerprint)
-            .with_context(|| format!("cannot write checkpoint {}", path.display())),
-        None => Ok(()),
+    let mut partial = match (limits.pass_seconds, &out, format) {
+        (Some(every), Some(out), Some(format)) => Some(partial::Partial::new(
+            every,
+            out.clone(),
+            format,
+            args.exposure,
+        )),
+        _ => None,
+    };
+    let mut after_pass = |film: &Film| {
+        if let Some(path) = &args.checkpoint {
+            checkpoint::save(path, film, &text, &fingerprint)
+                .with_context(|| format!("cannot write checkpoint {}", path.display()))?;
+        }
+        partial.as_mut().map_or(Ok(()), |p| p.after_pass(film))
     };
     let end = range.end;
     let run = || {

@@ -358,3 +358,54 @@ fn set_overrides_a_scene_key_and_refuses_a_bad_one() {
     assert!(err.contains("did you mean `vfov`?"), "{err}");
     assert!(!d.join("bad.png").exists());
 }
+
+/// With --partial-every, the output image exists, whole, while the render
+/// is still running (then it is interrupted).
+#[cfg(unix)]
+#[test]
+fn a_partial_image_exists_while_the_render_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lueur"))
+        .args([
+            "render",
+            &scene("donut-mirrors"),
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--spp",
+            "1000000",
+            "--partial-every",
+            "0.05",
+            "-o",
+            "p.png",
+        ])
+        .current_dir(d)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let image = d.join("p.png");
+    while !image.exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the render is still running"
+    );
+    assert!(
+        image.exists(),
+        "no partial image after {:?}",
+        start.elapsed()
+    );
+    let img = image::open(&image).expect("a whole PNG");
+    assert_eq!((img.width(), img.height()), (32, 32));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+}
