@@ -6,6 +6,7 @@ mod bar;
 mod checkpoint;
 mod crop;
 mod fingerprint;
+mod help;
 mod interrupt;
 mod merge;
 mod output;
@@ -48,6 +49,7 @@ struct Cli {
 enum Command {
     /// Render a scene file to an image (.png: 8-bit sRGB; .exr: linear float
     /// RGB plus the per-pixel variance of the mean).
+    #[command(after_help = help::render_after_help())]
     Render(RenderArgs),
     /// Generate a point set (CSV or PNG plot) and measure it: discrepancies
     /// and integration error.
@@ -56,6 +58,12 @@ enum Command {
     /// A..B --checkpoint FILE`) into the image of all their samples,
     /// bit-identical to rendering them at once.
     Merge(MergeArgs),
+    /// Print a shell completion script, e.g. `lueur completions bash >
+    /// ~/.local/share/bash-completion/completions/lueur`.
+    Completions {
+        /// The shell: bash, elvish, fish, powershell or zsh.
+        shell: clap_complete::Shell,
+    },
 }
 
 #[derive(Parser)]
@@ -225,6 +233,19 @@ fn main() -> ExitCode {
         Command::Render(args) => run_render(args),
         Command::Points(args) => points::run_points(args),
         Command::Merge(args) => run_merge(args),
+        Command::Completions { shell } => {
+            use clap::CommandFactory;
+            let mut command = Cli::command();
+            // Into memory first: the generator panics on a write error,
+            // and a closed pipe (`| head`) is no reason to.
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut command, "lueur", &mut script);
+            use std::io::Write;
+            match std::io::stdout().write_all(&script) {
+                Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+                _ => Ok(()),
+            }
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -409,3 +409,40 @@ fn a_partial_image_exists_while_the_render_runs() {
     let o = child.wait_with_output().unwrap();
     assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
 }
+
+/// `render --help` lists every strategy and sampler with a line each, and
+/// completions are generated for the usual shells.
+#[test]
+fn help_lists_strategies_and_samplers_and_completions_are_generated() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = lueur(&["render", "--help"], dir.path());
+    assert!(o.status.success());
+    let help = String::from_utf8(o.stdout).unwrap();
+    for name in [
+        "uniform",
+        "cosine",
+        "light",
+        "mixture",
+        "mis",
+        "independent",
+        "sobol-owen",
+        "zsobol",
+        "pmj02",
+    ] {
+        assert!(
+            help.lines()
+                .any(|l| l.trim_start().starts_with(&format!("{name} "))),
+            "{name} missing from {help}"
+        );
+    }
+    assert!(
+        help.contains("-t, --threads") && help.contains("-o, --out"),
+        "{help}"
+    );
+    for shell in ["bash", "zsh", "fish"] {
+        let o = lueur(&["completions", shell], dir.path());
+        assert!(o.status.success(), "{shell}");
+        let script = String::from_utf8(o.stdout).unwrap();
+        assert!(script.contains("crop-window"), "{shell}: {script}");
+    }
+}
