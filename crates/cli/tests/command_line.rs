@@ -446,3 +446,31 @@ fn help_lists_strategies_and_samplers_and_completions_are_generated() {
         assert!(script.contains("crop-window"), "{shell}: {script}");
     }
 }
+
+/// `--stats` on one thread says "1 thread", and shows no row for the
+/// shadow rays that `mixture` never casts.
+#[test]
+fn stats_speak_of_one_thread_and_skip_rays_never_cast() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = render(
+        dir.path(),
+        &[
+            "--spp",
+            "2",
+            "--strategy",
+            "mixture",
+            "--stats",
+            "-t",
+            "1",
+            "-o",
+            "s.png",
+        ],
+    );
+    let out = String::from_utf8(o.stdout).unwrap();
+    assert!(out.contains("time on 1 thread:"), "{out}");
+    assert!(
+        out.contains("camera  rays") && out.contains("bounce  rays"),
+        "{out}"
+    );
+    assert!(!out.contains("shadow"), "{out}");
+}
