@@ -11,6 +11,7 @@ mod interrupt;
 mod merge;
 mod output;
 mod partial;
+mod plot;
 mod points;
 mod progressive;
 mod resume;

@@ -183,8 +183,9 @@ fn points_csv_has_n_lines_of_d_coordinates_in_the_unit_cube() {
     assert!(o.status.success(), "{}", stderr(&o));
     let text = std::fs::read_to_string(dir.path().join("pts.csv")).unwrap();
     let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines.len(), 1024);
-    for line in lines {
+    assert_eq!(lines.len(), 1 + 1024, "a header and the points");
+    assert_eq!(lines[0], "x0,x1,x2");
+    for line in &lines[1..] {
         let values: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
         assert_eq!(values.len(), 3, "{line}");
         assert!(values.iter().all(|v| (0.0..1.0).contains(v)), "{line}");

@@ -474,3 +474,42 @@ fn stats_speak_of_one_thread_and_skip_rays_never_cast() {
     );
     assert!(!out.contains("shadow"), "{out}");
 }
+
+/// The points plot has a frame (a grey column of pixels as tall as the
+/// square's side), and --dims chooses the pair of dimensions shown.
+#[test]
+fn the_points_plot_has_a_frame_and_plots_the_dimensions_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let plot = |dims: &[&str], out: &str| {
+        let mut args = vec![
+            "points",
+            "--sampler",
+            "sobol-owen",
+            "-n",
+            "64",
+            "-d",
+            "4",
+            "-o",
+            out,
+        ];
+        args.extend_from_slice(dims);
+        let o = lueur(&args, d);
+        assert!(o.status.success(), "{}", stderr(&o));
+        image::open(d.join(out)).unwrap().to_luma8()
+    };
+    let first = plot(&[], "a.png");
+    let other = plot(&["--dims", "2", "3"], "b.png");
+    assert_ne!(first, other, "another pair of dimensions");
+    let tallest_grey_column = (0..first.width())
+        .map(|x| {
+            (0..first.height())
+                .filter(|&y| first.get_pixel(x, y).0[0] == 96)
+                .count()
+        })
+        .max()
+        .unwrap();
+    assert!(tallest_grey_column > 400, "a frame: {tallest_grey_column}");
+    let o = lueur(&["points", "-d", "2", "--dims", "0", "2", "-o", "c.png"], d);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
