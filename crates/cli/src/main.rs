@@ -16,10 +16,11 @@ mod points;
 mod progressive;
 mod resume;
 mod stats;
+mod summary;
 mod validate;
 
 use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
@@ -51,7 +52,7 @@ enum Command {
     /// Render a scene file to an image (.png: 8-bit sRGB; .exr: linear float
     /// RGB plus the per-pixel variance of the mean).
     #[command(after_help = help::render_after_help())]
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Generate a point set (CSV or PNG plot) and measure it: discrepancies
     /// and integration error.
     Points(points::PointsArgs),
@@ -231,7 +232,7 @@ impl std::error::Error for BadInput {}
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render(args) => run_render(args),
+        Command::Render(args) => run_render(*args),
         Command::Points(args) => points::run_points(args),
         Command::Merge(args) => run_merge(args),
         Command::Completions { shell } => {
@@ -290,56 +291,15 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         scene.marching = Marching::Naive;
     }
     let settings = apply_flags(parsed.settings, &args)?;
-    let range = match &args.sample_range {
-        Some(r) if r.end > settings.spp => {
-            return Err(BadInput(format!(
-                "--sample-range {}..{} ends past the render's {} spp (set the total with --spp)",
-                r.start, r.end, settings.spp
-            ))
-            .into());
-        }
-        Some(_) if args.checkpoint.is_none() => {
-            return Err(BadInput(
-                "--sample-range renders a shard: save it with --checkpoint FILE, for `lueur merge`"
-                    .into(),
-            )
-            .into());
-        }
-        Some(r) => r.clone(),
-        None => 0..settings.spp,
-    };
-    // A shard's image is optional; a whole render always writes one.
-    let out = match (&args.out, &args.sample_range) {
-        (Some(p), _) => Some(p.clone()),
-        (None, Some(_)) => None,
-        (None, None) => Some(default_output(&args.scene)),
-    };
-    let format = out
-        .as_deref()
-        .map(|p| validate::image_output("--out", p))
-        .transpose()?;
-    if let Some(path) = &args.checkpoint {
-        validate::checkpoint_output("--checkpoint", path)?;
-        if let Some(out) = &out {
-            validate::distinct(("--out", out), ("--checkpoint", path))?;
-        }
-    }
+    let range = render_range(&args, &settings)?;
+    let (out, format) = validate::render_outputs(&args)?;
     let bounds = crop::bounds(
         args.crop_window.as_deref(),
         args.pixel_bounds.as_deref(),
         settings.width,
         settings.height,
     )?;
-    let limits = progressive::Limits {
-        time: positive(args.time, "--time")?,
-        target_error: positive(args.target_error, "--target-error")?,
-        pass_seconds: positive(args.partial_every, "--partial-every")?,
-    };
-    if limits.pass_seconds.is_some() && out.is_none() {
-        bail!(BadInput(
-            "--partial-every writes the output image: give it with --out".into()
-        ));
-    }
+    let limits = render_limits(&args, out.is_some())?;
     progressive::install_signal_handler()?;
 
     let whole = PixelBounds::whole(settings.width, settings.height);
@@ -402,7 +362,6 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         )
     };
     let (output, stop) = match args.threads {
-        Some(0) => return Err(BadInput("--threads must be at least 1".into()).into()),
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
@@ -433,64 +392,60 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             .with_context(|| format!("cannot write {}", out.display()))?;
     }
 
-    let stats = &output.stats;
-    let secs = stats.elapsed.as_secs_f64();
-    let samples = match args.sample_range {
-        Some(_) => format!("samples {:?} of {}", output.film.samples(), settings.spp),
-        None => format!("{} spp", output.film.spp()),
-    };
-    let samples = match output.film.unfinished_pass() {
-        Some((pass, share)) => format!(
-            "{samples} ({:.0}% of the pixels at {})",
-            100.0 * share,
-            pass.end - output.film.samples().start
-        ),
-        None => samples,
-    };
-    let destination = out.as_ref().or(args.checkpoint.as_ref());
-    let say = |text: String| {
-        if !args.quiet {
-            eprintln!("{text}");
-        }
-    };
-    say(format!(
-        "rendered {}x{} at {samples} ({}, {}) in {:.2} s, {:.2} M samples/s -> {}",
-        output.film.width(),
-        output.film.height(),
-        settings.strategy,
-        settings.sampler.name(),
-        secs,
-        stats.samples as f64 / secs.max(1e-9) / 1e6,
-        destination.map_or_else(String::new, |p| p.display().to_string())
-    ));
-    if stats.dropped_samples > 0 {
-        eprintln!(
-            "warning: {} NaN or infinite samples were dropped",
-            stats.dropped_samples
-        );
-    }
-    if args.stats {
-        stats::print_stats(&output);
-    }
-    match stop {
-        progressive::Stop::Complete => {}
-        progressive::Stop::TimeBudget => {
-            let budget = args.time.unwrap_or_default();
-            say(format!(
-                "time budget of {budget} s: used {secs:.2} s ({:.0}%), stopped at {} of {} spp",
-                100.0 * secs / budget,
-                output.film.spp(),
-                range.end - range.start
-            ))
-        }
-        progressive::Stop::TargetError(e) => say(format!(
-            "target error reached: relative error {e:.4} at {} of {} spp",
-            output.film.spp(),
-            range.end - range.start
-        )),
-        progressive::Stop::Interrupted => return Err(interrupted().into()),
+    summary::report(
+        &args,
+        &settings,
+        &output,
+        stop,
+        out.as_deref(),
+        range.end - range.start,
+    );
+    if stop == progressive::Stop::Interrupted {
+        return Err(interrupted().into());
     }
     Ok(())
+}
+
+/// The sample indices to render: a shard's (`--sample-range`, which needs
+/// a checkpoint to save it in), or all of `0..spp`.
+/// When to stop or cut passes short: --time, --target-error,
+/// --partial-every (which needs an image to write, `has_out`).
+fn render_limits(args: &RenderArgs, has_out: bool) -> Result<progressive::Limits> {
+    if args.threads == Some(0) {
+        bail!(BadInput("--threads must be at least 1".into()));
+    }
+    let limits = progressive::Limits {
+        time: positive(args.time, "--time")?,
+        target_error: positive(args.target_error, "--target-error")?,
+        pass_seconds: positive(args.partial_every, "--partial-every")?,
+    };
+    if limits.pass_seconds.is_some() && !has_out {
+        bail!(BadInput(
+            "--partial-every writes the output image: give it with --out".into()
+        ));
+    }
+    Ok(limits)
+}
+
+fn render_range(args: &RenderArgs, settings: &RenderSettings) -> Result<Range<u32>> {
+    Ok(match &args.sample_range {
+        Some(r) if r.end > settings.spp => {
+            return Err(BadInput(format!(
+                "--sample-range {}..{} ends past the render's {} spp (set the total with --spp)",
+                r.start, r.end, settings.spp
+            ))
+            .into());
+        }
+        Some(_) if args.checkpoint.is_none() => {
+            return Err(BadInput(
+                "--sample-range renders a shard: save it with --checkpoint FILE, for `lueur merge`"
+                    .into(),
+            )
+            .into());
+        }
+        Some(r) => r.clone(),
+        None => 0..settings.spp,
+    })
 }
 
 fn run_merge(args: MergeArgs) -> Result<()> {
@@ -577,11 +532,4 @@ fn apply_flags(mut s: RenderSettings, a: &RenderArgs) -> Result<RenderSettings> 
     }
     s.validate().map_err(|e| BadInput(e.to_string()))?;
     Ok(s)
-}
-
-fn default_output(scene: &Path) -> PathBuf {
-    let stem = scene
-        .file_stem()
-        .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
-    PathBuf::from(format!("{stem}.png"))
 }

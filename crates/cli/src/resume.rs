@@ -50,20 +50,16 @@ pub fn restore(path: &Path, args: &mut RenderArgs) -> Result<Resumed, BadInput> 
     restore!(max_depth, "max_depth", |v: &str| v.parse().ok());
     restore!(roulette_depth, "roulette_depth", |v: &str| v.parse().ok());
     restore!(spp, "spp", |v: &str| v.parse().ok());
-    if args.crop_window.is_none() && args.pixel_bounds.is_none() {
-        if let Some(v) = fp.get("crop").filter(|v| *v != "none") {
-            let bounds: Option<Vec<u32>> = v.split(',').map(|x| x.parse().ok()).collect();
-            args.pixel_bounds = Some(
-                bounds
-                    .filter(|b| b.len() == 4)
-                    .ok_or_else(|| bad("crop", v))?,
-            );
-        }
+    if args.crop_window.is_none()
+        && args.pixel_bounds.is_none()
+        && let Some(v) = fp.get("crop").filter(|v| *v != "none")
+    {
+        let bounds: Option<Vec<u32>> = v.split(',').map(|x| x.parse().ok()).collect();
+        let bounds = bounds.filter(|b| b.len() == 4);
+        args.pixel_bounds = Some(bounds.ok_or_else(|| bad("crop", v))?);
     }
-    if restore_shard {
-        if let Some(v) = fp.get("shard").filter(|v| *v != "none") {
-            args.sample_range = Some(crate::parse_sample_range(v).map_err(|_| bad("shard", v))?);
-        }
+    if restore_shard && let Some(v) = fp.get("shard").filter(|v| *v != "none") {
+        args.sample_range = Some(crate::parse_sample_range(v).map_err(|_| bad("shard", v))?);
     }
     if fp.get("naive") == Some("true") {
         args.naive = true;

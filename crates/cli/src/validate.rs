@@ -4,8 +4,37 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::BadInput;
 use crate::output::{self, Format};
+use crate::{BadInput, RenderArgs};
+
+/// The image a render writes and its format, and its checkpoint, all
+/// checked: a shard's image is optional (`--out`); a whole render always
+/// writes one, by default `SCENE_NAME.png` in the current directory.
+pub fn render_outputs(args: &RenderArgs) -> Result<(Option<PathBuf>, Option<Format>), BadInput> {
+    let out = match (&args.out, &args.sample_range) {
+        (Some(p), _) => Some(p.clone()),
+        (None, Some(_)) => None,
+        (None, None) => Some(default_output(&args.scene)),
+    };
+    let format = out
+        .as_deref()
+        .map(|p| image_output("--out", p))
+        .transpose()?;
+    if let Some(path) = &args.checkpoint {
+        checkpoint_output("--checkpoint", path)?;
+        if let Some(out) = &out {
+            distinct(("--out", out), ("--checkpoint", path))?;
+        }
+    }
+    Ok((out, format))
+}
+
+fn default_output(scene: &Path) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
+    PathBuf::from(format!("{stem}.png"))
+}
 
 /// Checks that `path`, given to `flag`, can receive an image: a `.png` or
 /// `.exr` name in a directory that exists and accepts new files. Returns
