@@ -136,8 +136,8 @@ struct RenderArgs {
     /// reference that speed-ups are measured against.
     #[arg(long)]
     naive: bool,
-    /// Stop at this wall-clock budget in seconds, after the last whole pass
-    /// that fits (passes of 1, 1, 2, 4, ... spp; the first always runs).
+    /// Stop at this wall-clock budget in seconds: passes of 1, 1, 2, 4, ...
+    /// spp, the last ones cut to what is left (the first always runs).
     #[arg(long, value_name = "SECONDS")]
     time: Option<f64>,
     /// Stop once the image's relative standard error (RMS pixel standard

@@ -1,7 +1,9 @@
 //! Progressive rendering for the CLI: passes of 1, 1, 2, 4, ... samples per
-//! pixel (pbrt's schedule), so the film holds a whole number of samples per
-//! pixel after every pass and a render can stop there, on a time budget or
-//! an error target. A signal stops it sooner, after the tiles in flight:
+//! pixel (pbrt's schedule), cut shorter to fit a time budget or a
+//! partial-image interval (the dyadic film adds any range of samples
+//! exactly), so the film holds a whole number of samples per pixel after
+//! every pass and a render can stop there, on a time budget or an error
+//! target. A signal stops it sooner, after the tiles in flight:
 //! every finished tile is kept, so it loses no more than a tile per thread.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
