@@ -26,6 +26,9 @@ pub fn render_outputs(args: &RenderArgs) -> Result<(Option<PathBuf>, Option<Form
             distinct(("--out", out), ("--checkpoint", path))?;
         }
     }
+    if let (Some(out), Some(resume)) = (&out, &args.resume) {
+        distinct(("--out", out), ("--resume", resume))?;
+    }
     Ok((out, format))
 }
 
