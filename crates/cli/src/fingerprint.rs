@@ -131,7 +131,14 @@ impl Fingerprint {
             .into_iter()
             .filter(|n| !TARGETS.contains(n) || (spp_matters && *n == "spp"))
             .filter_map(|n| {
-                let (a, b) = (self.get(n), other.get(n));
+                // Fields added later read, where a checkpoint lacks them, as
+                // the value every older render had.
+                let old = match n {
+                    "crop" | "shard" => Some("none"),
+                    "set" => Some("[]"),
+                    _ => None,
+                };
+                let (a, b) = (self.get(n).or(old), other.get(n).or(old));
                 (a != b).then(|| {
                     format!(
                         "{n}: {}, {}",
@@ -208,5 +215,13 @@ mod tests {
         assert_eq!(old.get("width"), Some("8"));
         assert_eq!(old.get("crop"), None);
         assert!(old.overrides().is_empty());
+        // A checkpoint of an older lueur had no crop, shard or overrides.
+        let now = Fingerprint::parse("width=8 height=4 strategy=mis naive=false crop=none set=[]");
+        assert!(old.differences(&now, false).is_empty());
+        let cropped = Fingerprint::parse("width=8 height=4 strategy=mis naive=false crop=1,2,1,2");
+        assert_eq!(
+            old.differences(&cropped, false),
+            vec!["crop: none, 1,2,1,2"]
+        );
     }
 }
