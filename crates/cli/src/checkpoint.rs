@@ -10,46 +10,20 @@
 //! deviations, stored exactly, so that continuing merges the very same
 //! numbers). Attributes of every layer record its sample range and what the
 //! film is a render *of*: the scene file's full text and the settings that
-//! decide a sample's value. A resume or merge whose scene or settings differ
-//! is refused with a message saying which.
+//! decide a sample's value (`crate::fingerprint`). A resume or merge whose
+//! scene or settings differ is refused with a message saying which.
 
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use exr::prelude::*;
-use lueur_integrator::{Film, PixelStats, RenderSettings};
+use lueur_integrator::{Film, PixelStats};
 
 const LAYER_PREFIX: &str = "lueur-samples-";
 const ATTR_START: &str = "lueur.samples.start";
 const ATTR_END: &str = "lueur.samples.end";
 const ATTR_SCENE: &str = "lueur.scene";
 const ATTR_SETTINGS: &str = "lueur.settings";
-
-/// What, besides the scene text, must match for samples to add up: every
-/// setting that changes a sample's value. The spp target is not among them,
-/// so a render can be resumed to more samples, except with the samplers
-/// whose patterns are laid out over the total spp.
-pub fn settings_fingerprint(s: &RenderSettings, naive: bool) -> String {
-    let spp = if s.sampler.depends_on_spp() {
-        format!(" spp={}", s.spp)
-    } else {
-        String::new()
-    };
-    format!(
-        "width={} height={} strategy={} sampler={} seed={} max_depth={} roulette_depth={} max_steps={} \
-         pixel_epsilon={} epsilon={} naive={naive}{spp}",
-        s.width,
-        s.height,
-        s.strategy,
-        s.sampler,
-        s.seed,
-        s.max_depth,
-        s.roulette_depth,
-        s.max_steps,
-        s.pixel_epsilon,
-        s.epsilon_rel,
-    )
-}
 
 /// One pixel as a checkpoint stores it, channels in the file's
 /// (alphabetical) order.
@@ -136,28 +110,10 @@ fn text(s: &str) -> Result<Text> {
     Text::new_or_none(s).context("the checkpoint's text must be ASCII (Latin-1)")
 }
 
-/// A film read back from a checkpoint, with what it is a render of.
+/// A film read back from a checkpoint (what it is a render of is in its
+/// [`Header`]).
 pub struct Saved {
     pub film: Film,
-    pub scene_text: String,
-    pub fingerprint: String,
-}
-
-/// Reads a checkpoint and checks it is a render of `scene_text` with
-/// settings `fingerprint`.
-pub fn load(path: &Path, scene_text: &str, fingerprint: &str) -> Result<Film> {
-    let name = path.display();
-    let saved = read_film(path)?;
-    if saved.scene_text != scene_text {
-        bail!("{name} is a render of a different scene file (its text differs); cannot resume");
-    }
-    if saved.fingerprint != fingerprint {
-        bail!(
-            "{name} was rendered with other settings; cannot resume.\n  checkpoint: {}\n  now:        {fingerprint}",
-            saved.fingerprint
-        );
-    }
-    Ok(saved.film)
 }
 
 /// What a checkpoint's headers say, read without its pixels.
@@ -263,9 +219,5 @@ pub fn read_film(path: &Path) -> Result<Saved> {
     let start = blocks[0].0.start;
     let film = Film::from_blocks(w, h, start, blocks)
         .with_context(|| format!("{name}: inconsistent checkpoint data"))?;
-    Ok(Saved {
-        film,
-        scene_text: header.scene_text,
-        fingerprint: header.fingerprint,
-    })
+    Ok(Saved { film })
 }

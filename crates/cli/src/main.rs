@@ -2,22 +2,35 @@
 //! crates: it reads scene files, draws the progress bar and writes images;
 //! every decision about light lives in `lueur-integrator`.
 
+mod bar;
 mod checkpoint;
+mod crop;
+mod fingerprint;
+mod help;
+mod interrupt;
+mod merge;
 mod output;
+mod partial;
+mod plot;
 mod points;
 mod progressive;
+mod resume;
 mod stats;
+mod summary;
+mod validate;
 
 use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use indicatif::{ProgressBar, ProgressStyle};
-use lueur_integrator::{Film, Marching, RenderOutput, RenderSettings, Strategy};
+use lueur_integrator::{Film, Marching, PixelBounds, RenderOutput, RenderSettings, Strategy};
 use lueur_sampling::SamplerKind;
-use lueur_scene::{SceneFileError, parse_scene};
+use lueur_scene::{SceneFileError, parse_scene_with};
+
+use fingerprint::Fingerprint;
+use interrupt::Interrupted;
 
 /// Exit status for input the user must fix (scene files, flags), as clap
 /// does for usage errors.
@@ -38,7 +51,8 @@ struct Cli {
 enum Command {
     /// Render a scene file to an image (.png: 8-bit sRGB; .exr: linear float
     /// RGB plus the per-pixel variance of the mean).
-    Render(RenderArgs),
+    #[command(after_help = help::render_after_help())]
+    Render(Box<RenderArgs>),
     /// Generate a point set (CSV or PNG plot) and measure it: discrepancies
     /// and integration error.
     Points(points::PointsArgs),
@@ -46,6 +60,12 @@ enum Command {
     /// A..B --checkpoint FILE`) into the image of all their samples,
     /// bit-identical to rendering them at once.
     Merge(MergeArgs),
+    /// Print a shell completion script, e.g. `lueur completions bash >
+    /// ~/.local/share/bash-completion/completions/lueur`.
+    Completions {
+        /// The shell: bash, elvish, fish, powershell or zsh.
+        shell: clap_complete::Shell,
+    },
 }
 
 #[derive(Parser)]
@@ -62,6 +82,10 @@ struct MergeArgs {
     /// Exposure in stops applied before PNG encoding (EXR stays linear).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     exposure: f32,
+    /// Merge shards that do not hold every sample of the render (missing
+    /// samples at its start or end); refused otherwise, listing them.
+    #[arg(long)]
+    allow_partial: bool,
 }
 
 #[derive(Parser)]
@@ -97,11 +121,14 @@ struct RenderArgs {
     #[arg(long)]
     height: Option<u32>,
     /// Worker threads (default: one per core). The image does not depend on it.
-    #[arg(long)]
+    #[arg(long, short = 't')]
     threads: Option<usize>,
     /// Exposure in stops applied before PNG encoding (EXR stays linear).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     exposure: f32,
+    /// Print nothing but errors and warnings: no progress bar, no summary.
+    #[arg(long, short = 'q')]
+    quiet: bool,
     /// Print statistics after the render: rays, steps per ray, hit shares.
     #[arg(long)]
     stats: bool,
@@ -109,8 +136,8 @@ struct RenderArgs {
     /// reference that speed-ups are measured against.
     #[arg(long)]
     naive: bool,
-    /// Stop at this wall-clock budget in seconds, after the last whole pass
-    /// that fits (passes of 1, 1, 2, 4, ... spp; the first always runs).
+    /// Stop at this wall-clock budget in seconds: passes of 1, 1, 2, 4, ...
+    /// spp, the last ones cut to what is left (the first always runs).
     #[arg(long, value_name = "SECONDS")]
     time: Option<f64>,
     /// Stop once the image's relative standard error (RMS pixel standard
@@ -130,6 +157,24 @@ struct RenderArgs {
     /// where the shard is saved for `lueur merge`; --out is then optional.
     #[arg(long, value_name = "START..END", value_parser = parse_sample_range)]
     sample_range: Option<Range<u32>>,
+    /// Override a scene-file key by its dotted path, as the file would set
+    /// it (repeatable): camera.vfov=30, render.max_steps=64,
+    /// lights[0].radiance=[1,1,1].
+    #[arg(long = "set", short = 'D', value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Render only this part of the image, in fractions of its width and
+    /// height (pbrt-v4's --cropwindow; row 0 at the top); the image written
+    /// is the crop's size, its pixels those of the full render.
+    #[arg(long, num_args = 4, value_names = ["X0", "X1", "Y0", "Y1"], conflicts_with = "pixel_bounds")]
+    crop_window: Option<Vec<f64>>,
+    /// Render only pixels X0..X1 x Y0..Y1 of the image, ends excluded
+    /// (pbrt-v4's --pixelbounds).
+    #[arg(long, num_args = 4, value_names = ["X0", "X1", "Y0", "Y1"])]
+    pixel_bounds: Option<Vec<u32>>,
+    /// Write the output image every SECONDS while rendering (atomically,
+    /// between passes), for a viewer that reloads it.
+    #[arg(long, value_name = "SECONDS")]
+    partial_every: Option<f64>,
 }
 
 fn parse_sample_range(s: &str) -> Result<Range<u32>, String> {
@@ -162,52 +207,6 @@ fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
     })
 }
 
-/// The render was stopped by a signal; what was complete has been written.
-#[derive(Debug)]
-struct Interrupted {
-    /// Samples per pixel that every pixel has.
-    spp: u32,
-    /// The interrupted pass's end and the share of pixels that reached it.
-    unfinished: Option<(u32, f64)>,
-    /// The checkpoint, which holds the last complete pass.
-    checkpoint: Option<PathBuf>,
-}
-
-impl std::fmt::Display for Interrupted {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        if self.spp == 0 {
-            return write!(
-                f,
-                "interrupted before the first pass completed; nothing written"
-            );
-        }
-        write!(
-            f,
-            "interrupted: wrote the {} spp completed before the signal",
-            self.spp
-        )?;
-        if let Some((end, share)) = self.unfinished {
-            write!(
-                f,
-                ", and {end} spp in the {:.0}% of the pixels whose tiles finished the pass in \
-                 progress",
-                100.0 * share
-            )?;
-        }
-        if let Some(path) = &self.checkpoint {
-            write!(
-                f,
-                "; {} holds the {} spp (resume from it)",
-                path.display(),
-                self.spp
-            )?;
-        }
-        Ok(())
-    }
-}
-
-impl std::error::Error for Interrupted {}
-
 /// `Some(v)` if `v` is positive and finite, a usage error otherwise.
 fn positive(v: Option<f64>, flag: &str) -> Result<Option<f64>> {
     match v {
@@ -233,9 +232,22 @@ impl std::error::Error for BadInput {}
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render(args) => run_render(args),
+        Command::Render(args) => run_render(*args),
         Command::Points(args) => points::run_points(args),
         Command::Merge(args) => run_merge(args),
+        Command::Completions { shell } => {
+            use clap::CommandFactory;
+            let mut command = Cli::command();
+            // Into memory first: the generator panics on a write error,
+            // and a closed pipe (`| head`) is no reason to.
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut command, "lueur", &mut script);
+            use std::io::Write;
+            match std::io::stdout().write_all(&script) {
+                Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+                _ => Ok(()),
+            }
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -247,10 +259,11 @@ fn main() -> ExitCode {
                 }
                 return ExitCode::from(EXIT_BAD_INPUT);
             }
-            eprintln!("error: {e:#}");
-            if e.downcast_ref::<Interrupted>().is_some() {
+            if let Some(interrupted) = e.downcast_ref::<Interrupted>() {
+                eprintln!("{interrupted}");
                 return ExitCode::from(progressive::EXIT_INTERRUPTED);
             }
+            eprintln!("error: {}", validate::error_chain(&e));
             if e.downcast_ref::<BadInput>().is_some() {
                 ExitCode::from(EXIT_BAD_INPUT)
             } else {
@@ -260,17 +273,162 @@ fn main() -> ExitCode {
     }
 }
 
-fn run_render(args: RenderArgs) -> Result<()> {
+fn run_render(mut args: RenderArgs) -> Result<()> {
     let file = args.scene.display().to_string();
     let text = std::fs::read_to_string(&args.scene)
         .map_err(|e| BadInput(format!("cannot read scene file {file}: {e}")))?;
-    let parsed = parse_scene(&text, &file)?;
+    let resumed = match args.resume.clone() {
+        Some(path) => {
+            validate::input("--resume", &path)?;
+            Some(resume::restore(&path, &mut args)?)
+        }
+        None => None,
+    };
+    let overrides: Vec<&str> = args.set.iter().map(String::as_str).collect();
+    let parsed = parse_scene_with(&text, &file, &overrides)?;
     let mut scene = parsed.scene;
     if args.naive {
         scene.marching = Marching::Naive;
     }
     let settings = apply_flags(parsed.settings, &args)?;
-    let range = match &args.sample_range {
+    let range = render_range(&args, &settings)?;
+    let (out, format) = validate::render_outputs(&args)?;
+    let bounds = crop::bounds(
+        args.crop_window.as_deref(),
+        args.pixel_bounds.as_deref(),
+        settings.width,
+        settings.height,
+    )?;
+    let limits = render_limits(&args, out.is_some())?;
+    progressive::install_signal_handler()?;
+
+    let whole = PixelBounds::whole(settings.width, settings.height);
+    let region = bounds.unwrap_or(whole);
+    let pixels = u64::from(region.width()) * u64::from(region.height());
+    let fingerprint = Fingerprint::of(
+        &settings,
+        args.naive,
+        bounds,
+        args.sample_range.as_ref(),
+        &args.set,
+    );
+    let film = match (&args.resume, &resumed) {
+        (Some(path), Some(resumed)) => {
+            resume::load(path, resumed, &text, &fingerprint, settings.sampler, &range)?
+        }
+        _ => Film::starting_at(region.width(), region.height(), range.start),
+    };
+    let fingerprint = fingerprint.to_string();
+    // Without a checkpoint nobody will extend the film: it can keep one
+    // image instead of one per dyadic block (two at 24 spp, three at 100).
+    let film = match args.checkpoint {
+        Some(_) => film,
+        None => film.sealed_at(range.end),
+    };
+    let bar = bar::Bar::new(
+        pixels * u64::from(range.end - range.start),
+        pixels * u64::from(film.spp().min(range.end - range.start)),
+        limits.time,
+        args.quiet,
+    );
+    let progress = |n: u64| bar.add(n);
+    let mut partial = match (limits.pass_seconds, &out, format) {
+        (Some(every), Some(out), Some(format)) => Some(partial::Partial::new(
+            every,
+            out.clone(),
+            format,
+            args.exposure,
+        )),
+        _ => None,
+    };
+    let mut after_pass = |film: &Film| {
+        if let Some(path) = &args.checkpoint {
+            checkpoint::save(path, film, &text, &fingerprint)
+                .with_context(|| format!("cannot write checkpoint {}", path.display()))?;
+        }
+        partial.as_mut().map_or(Ok(()), |p| p.after_pass(film))
+    };
+    let end = range.end;
+    let run = || {
+        progressive::render(
+            &scene,
+            &settings,
+            region,
+            film,
+            end,
+            limits,
+            &progress,
+            &mut after_pass,
+        )
+    };
+    let (output, stop) = match args.threads {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .context("cannot start the worker threads")?
+            .install(run),
+        None => run(),
+    }?;
+    bar.finish();
+    let output: RenderOutput = output;
+    let interrupted = || Interrupted {
+        spp: output.film.spp(),
+        unfinished: output
+            .film
+            .unfinished_pass()
+            .map(|(samples, share)| (samples.end - output.film.samples().start, share)),
+        out: out.clone().filter(|_| output.film.spp() > 0),
+        checkpoint: args.checkpoint.clone(),
+        scene: args.scene.clone(),
+    };
+    if output.film.spp() == 0 {
+        // Interrupted during the first pass: a partly black image is of no
+        // use to anyone.
+        return Err(interrupted().into());
+    }
+
+    if let (Some(out), Some(format)) = (&out, format) {
+        output::write_image(out, format, &output.film, args.exposure)
+            .with_context(|| format!("cannot write {}", out.display()))?;
+    }
+
+    summary::report(
+        &args,
+        &settings,
+        &output,
+        stop,
+        out.as_deref(),
+        range.end - range.start,
+    );
+    if stop == progressive::Stop::Interrupted {
+        return Err(interrupted().into());
+    }
+    Ok(())
+}
+
+/// The sample indices to render: a shard's (`--sample-range`, which needs
+/// a checkpoint to save it in), or all of `0..spp`.
+/// When to stop or cut passes short: --time, --target-error,
+/// --partial-every (which needs an image to write, `has_out`).
+fn render_limits(args: &RenderArgs, has_out: bool) -> Result<progressive::Limits> {
+    if args.threads == Some(0) {
+        bail!(BadInput("--threads must be at least 1".into()));
+    }
+    let limits = progressive::Limits {
+        time: positive(args.time, "--time")?,
+        target_error: positive(args.target_error, "--target-error")?,
+        pass_seconds: positive(args.partial_every, "--partial-every")?,
+    };
+    if limits.pass_seconds.is_some() && !has_out {
+        bail!(BadInput(
+            "--partial-every writes the output image: give it with --out".into()
+        ));
+    }
+    Ok(limits)
+}
+
+fn render_range(args: &RenderArgs, settings: &RenderSettings) -> Result<Range<u32>> {
+    Ok(match &args.sample_range {
         Some(r) if r.end > settings.spp => {
             return Err(BadInput(format!(
                 "--sample-range {}..{} ends past the render's {} spp (set the total with --spp)",
@@ -287,213 +445,27 @@ fn run_render(args: RenderArgs) -> Result<()> {
         }
         Some(r) => r.clone(),
         None => 0..settings.spp,
-    };
-    // A shard's image is optional; a whole render always writes one.
-    let out = match (&args.out, &args.sample_range) {
-        (Some(p), _) => Some(p.clone()),
-        (None, Some(_)) => None,
-        (None, None) => Some(default_output(&args.scene)),
-    };
-    let format = out
-        .as_deref()
-        .map(output::Format::from_path)
-        .transpose()
-        .map_err(|e| BadInput(e.to_string()))?;
-
-    let limits = progressive::Limits {
-        time: positive(args.time, "--time")?,
-        target_error: positive(args.target_error, "--target-error")?,
-    };
-    progressive::install_signal_handler()?;
-
-    let pixels = u64::from(settings.width) * u64::from(settings.height);
-    let bar = ProgressBar::new(pixels * u64::from(range.end - range.start));
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {wide_bar} {percent}% ETA {eta}",
-        )
-        .expect("the template is valid"),
-    );
-    let progress = |n: u64| bar.inc(n);
-    let fingerprint = checkpoint::settings_fingerprint(&settings, args.naive);
-    let film = match &args.resume {
-        Some(path) => {
-            let film = checkpoint::load(path, &text, &fingerprint)
-                .map_err(|e| BadInput(format!("{e:#}")))?;
-            if film.samples().start != range.start {
-                return Err(BadInput(format!(
-                    "{} holds samples {:?}, which do not start at {}",
-                    path.display(),
-                    film.samples(),
-                    range.start
-                ))
-                .into());
-            }
-            film
-        }
-        None => Film::starting_at(settings.width, settings.height, range.start),
-    };
-    // Without a checkpoint nobody will extend the film: it can keep one
-    // image instead of one per dyadic block (two at 24 spp, three at 100).
-    let film = match args.checkpoint {
-        Some(_) => film,
-        None => film.sealed_at(range.end),
-    };
-    bar.inc(pixels * u64::from(film.spp().min(range.end - range.start)));
-    let mut after_pass = |film: &Film| match &args.checkpoint {
-        Some(path) => checkpoint::save(path, film, &text, &fingerprint)
-            .with_context(|| format!("cannot write checkpoint {}", path.display())),
-        None => Ok(()),
-    };
-    let end = range.end;
-    let run = || {
-        progressive::render(
-            &scene,
-            &settings,
-            film,
-            end,
-            limits,
-            &progress,
-            &mut after_pass,
-        )
-    };
-    let (output, stop) = match args.threads {
-        Some(0) => return Err(BadInput("--threads must be at least 1".into()).into()),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .context("cannot start the worker threads")?
-            .install(run),
-        None => run(),
-    }?;
-    bar.finish_and_clear();
-    let output: RenderOutput = output;
-    let interrupted = || Interrupted {
-        spp: output.film.spp(),
-        unfinished: output
-            .film
-            .unfinished_pass()
-            .map(|(samples, share)| (samples.end - output.film.samples().start, share)),
-        checkpoint: args.checkpoint.clone(),
-    };
-    if output.film.spp() == 0 {
-        // Interrupted during the first pass: a partly black image is of no
-        // use to anyone.
-        return Err(interrupted().into());
-    }
-
-    if let (Some(out), Some(format)) = (&out, format) {
-        output::write_image(out, format, &output.film, args.exposure)
-            .with_context(|| format!("cannot write {}", out.display()))?;
-    }
-
-    let stats = &output.stats;
-    let secs = stats.elapsed.as_secs_f64();
-    let samples = match args.sample_range {
-        Some(_) => format!("samples {:?} of {}", output.film.samples(), settings.spp),
-        None => format!("{} spp", output.film.spp()),
-    };
-    let samples = match output.film.unfinished_pass() {
-        Some((pass, share)) => format!(
-            "{samples} ({:.0}% of the pixels at {})",
-            100.0 * share,
-            pass.end - output.film.samples().start
-        ),
-        None => samples,
-    };
-    let destination = out.as_ref().or(args.checkpoint.as_ref());
-    eprintln!(
-        "rendered {}x{} at {samples} ({}, {}) in {:.2} s, {:.2} M samples/s -> {}",
-        settings.width,
-        settings.height,
-        settings.strategy,
-        settings.sampler.name(),
-        secs,
-        stats.samples as f64 / secs.max(1e-9) / 1e6,
-        destination.map_or_else(String::new, |p| p.display().to_string())
-    );
-    if stats.dropped_samples > 0 {
-        eprintln!(
-            "warning: {} NaN or infinite samples were dropped",
-            stats.dropped_samples
-        );
-    }
-    if args.stats {
-        stats::print_stats(&output);
-    }
-    match stop {
-        progressive::Stop::Complete => {}
-        progressive::Stop::TimeBudget => eprintln!(
-            "time budget of {} s reached: stopped at {} of {} spp",
-            args.time.unwrap_or_default(),
-            output.film.spp(),
-            range.end - range.start
-        ),
-        progressive::Stop::TargetError(e) => eprintln!(
-            "target error reached: relative error {e:.4} at {} of {} spp",
-            output.film.spp(),
-            range.end - range.start
-        ),
-        progressive::Stop::Interrupted => return Err(interrupted().into()),
-    }
-    Ok(())
+    })
 }
 
 fn run_merge(args: MergeArgs) -> Result<()> {
-    let format = output::Format::from_path(&args.out).map_err(|e| BadInput(e.to_string()))?;
+    let format = validate::image_output("--out", &args.out)?;
+    if let Some(path) = &args.checkpoint {
+        validate::checkpoint_output("--checkpoint", path)?;
+        validate::distinct(("--out", &args.out), ("--checkpoint", path))?;
+    }
     if !args.exposure.is_finite() {
         bail!(BadInput("--exposure must be finite".into()));
     }
     // Headers first: every refusal comes before any pixel is read, and the
     // shards are then loaded one at a time, in order, each merged into the
     // film and dropped (8 shards of a 4K render never sit in memory at once).
-    let mut shards = Vec::new();
-    let mut first: Option<(PathBuf, String, String)> = None;
-    for path in &args.shards {
-        let header = checkpoint::read_header(path).map_err(|e| BadInput(format!("{e:#}")))?;
-        match &first {
-            None => {
-                first = Some((
-                    path.clone(),
-                    header.scene_text.clone(),
-                    header.fingerprint.clone(),
-                ))
-            }
-            Some((p, scene, _)) if *scene != header.scene_text => bail!(BadInput(format!(
-                "{} and {} are renders of different scene files; cannot merge",
-                p.display(),
-                path.display()
-            ))),
-            Some((p, _, settings)) if *settings != header.fingerprint => {
-                bail!(BadInput(format!(
-                    "{} and {} were rendered with different settings; cannot merge.\n  {}: {settings}\n  {}: {}",
-                    p.display(),
-                    path.display(),
-                    p.display(),
-                    path.display(),
-                    header.fingerprint
-                )))
-            }
-            Some(_) => {}
-        }
-        shards.push((path.clone(), header.samples));
-    }
-    let (_, scene_text, fingerprint) = first.expect("clap requires one shard");
-    // Name the files on either side of a gap or an overlap.
-    shards.sort_by_key(|(_, samples)| samples.start);
-    for pair in shards.windows(2) {
-        let (a, b) = (&pair[0], &pair[1]);
-        if a.1.end != b.1.start {
-            bail!(BadInput(format!(
-                "{} holds samples {:?} and {} holds {:?}: shards must follow each other \
-                 without gap or overlap",
-                a.0.display(),
-                a.1,
-                b.0.display(),
-                b.1
-            )));
-        }
-    }
+    let merge::Shards {
+        shards,
+        scene_text,
+        fingerprint,
+    } = merge::plan(&args.shards, args.allow_partial)?;
+    let fingerprint = fingerprint.to_string();
     let count = shards.len();
     let mut film: Option<Film> = None;
     for (path, _) in &shards {
@@ -560,11 +532,4 @@ fn apply_flags(mut s: RenderSettings, a: &RenderArgs) -> Result<RenderSettings> 
     }
     s.validate().map_err(|e| BadInput(e.to_string()))?;
     Ok(s)
-}
-
-fn default_output(scene: &Path) -> PathBuf {
-    let stem = scene
-        .file_stem()
-        .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
-    PathBuf::from(format!("{stem}.png"))
 }

@@ -72,7 +72,8 @@ pub fn remove_temporaries() {
     }
 }
 
-fn temporary_path(path: &Path) -> PathBuf {
+/// The temporary file beside `path` that a write of `path` goes to.
+pub fn temporary_path(path: &Path) -> PathBuf {
     let name = path
         .file_name()
         .map_or_else(|| "image".into(), |n| n.to_string_lossy().into_owned());

@@ -12,10 +12,8 @@ use lueur_sampling::pointsets::{
     l2_star_discrepancy, star_discrepancy_2d, wraparound_l2_discrepancy,
 };
 
-use crate::BadInput;
+use crate::{BadInput, plot};
 
-/// Side of the PNG plot, in pixels.
-const PLOT_SIZE: u32 = 512;
 /// The exact star discrepancy is `O(n^2 log n)`: computed up to this `n`.
 const MAX_EXACT_STAR: usize = 4096;
 /// The L2 discrepancies are `O(n^2 d)`: computed up to this `n`.
@@ -36,9 +34,9 @@ pub struct PointsArgs {
     /// Seed of the randomization (ignored by plain halton and sobol).
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Output file: .csv (one point per line) or .png (a plot of the first
-    /// two dimensions). Without it and without --metrics, CSV goes to
-    /// standard output.
+    /// Output file: .csv (a header, then one point per line) or .png (a
+    /// plot of two dimensions, --dims). Without it and without --metrics,
+    /// CSV goes to standard output.
     #[arg(long, short)]
     out: Option<PathBuf>,
     /// Print the discrepancies and the integration MSE of the Gaussian,
@@ -46,6 +44,9 @@ pub struct PointsArgs {
     /// --seed, at the same n).
     #[arg(long)]
     metrics: bool,
+    /// The two dimensions the PNG plots, across and up.
+    #[arg(long, num_args = 2, value_names = ["I", "J"], default_values_t = [0, 1])]
+    dims: Vec<usize>,
     /// Randomizations averaged by the integration MSE.
     #[arg(long, default_value_t = 64)]
     randomizations: usize,
@@ -93,8 +94,16 @@ pub fn run_points(args: PointsArgs) -> Result<()> {
         return Err(BadInput("-n must be at least 1".into()).into());
     }
     let format = args.out.as_deref().map(output_format).transpose()?;
+    let (i, j) = (args.dims[0], args.dims[1]);
     if matches!(format, Some(OutputFormat::Png)) && args.dim < 2 {
         return Err(BadInput("a PNG plot needs at least 2 dimensions (-d 2)".into()).into());
+    }
+    if i == j || i.max(j) >= args.dim {
+        return Err(BadInput(format!(
+            "--dims {i} {j}: two different dimensions below -d {}",
+            args.dim
+        ))
+        .into());
     }
     let points = generate(args.sampler, args.count, args.dim, args.seed)
         .map_err(|e| BadInput(e.to_string()))?;
@@ -111,9 +120,9 @@ pub fn run_points(args: PointsArgs) -> Result<()> {
             );
         }
         (Some(path), Some(OutputFormat::Png)) => {
-            write_atomically(path, |tmp| write_png(tmp, &points))?;
+            write_atomically(path, |tmp| plot::write_png(tmp, &points, i, j))?;
             eprintln!(
-                "plotted {} {} points -> {}",
+                "plotted dimensions {i} and {j} of {} {} points -> {}",
                 points.len(),
                 args.sampler,
                 path.display()
@@ -132,9 +141,12 @@ pub fn run_points(args: PointsArgs) -> Result<()> {
     Ok(())
 }
 
-/// One point per line, coordinates separated by commas, each printed with
-/// the shortest decimal that reads back to the same `f64`.
+/// A header naming the dimensions (`x0,x1,...`), then one point per line,
+/// coordinates separated by commas, each printed with the shortest decimal
+/// that reads back to the same `f64`.
 fn csv_lines(out: &mut impl Write, points: &PointSet) -> std::io::Result<()> {
+    let header: Vec<String> = (0..points.dim()).map(|d| format!("x{d}")).collect();
+    writeln!(out, "{}", header.join(","))?;
     for p in points.points() {
         let line: Vec<String> = p.iter().map(|x| x.to_string()).collect();
         writeln!(out, "{}", line.join(","))?;
@@ -145,27 +157,6 @@ fn csv_lines(out: &mut impl Write, points: &PointSet) -> std::io::Result<()> {
 fn write_csv(path: &Path, points: &PointSet) -> Result<()> {
     let file = std::fs::File::create(path)?;
     csv_lines(&mut std::io::BufWriter::new(file), points)?;
-    Ok(())
-}
-
-/// The first two dimensions as black 3x3 dots on white, `y` upwards.
-fn write_png(path: &Path, points: &PointSet) -> Result<()> {
-    let size = PLOT_SIZE;
-    let mut img = image::GrayImage::from_pixel(size, size, image::Luma([255]));
-    for p in points.points() {
-        // Coordinates are in [0, 1), so the pixel is in 0..size.
-        let cx = (p[0] * f64::from(size)) as i64;
-        let cy = i64::from(size) - 1 - (p[1] * f64::from(size)) as i64;
-        for dy in -1..=1 {
-            for dx in -1..=1 {
-                let (x, y) = (cx + dx, cy + dy);
-                if (0..i64::from(size)).contains(&x) && (0..i64::from(size)).contains(&y) {
-                    img.put_pixel(x as u32, y as u32, image::Luma([0]));
-                }
-            }
-        }
-    }
-    img.save_with_format(path, image::ImageFormat::Png)?;
     Ok(())
 }
 

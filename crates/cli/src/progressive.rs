@@ -1,13 +1,17 @@
 //! Progressive rendering for the CLI: passes of 1, 1, 2, 4, ... samples per
-//! pixel (pbrt's schedule), so the film holds a whole number of samples per
-//! pixel after every pass and a render can stop there, on a time budget or
-//! an error target. A signal stops it sooner, after the tiles in flight:
+//! pixel (pbrt's schedule), cut shorter to fit a time budget or a
+//! partial-image interval (the dyadic film adds any range of samples
+//! exactly), so the film holds a whole number of samples per pixel after
+//! every pass and a render can stop there, on a time budget or an error
+//! target. A signal stops it sooner, after the tiles in flight:
 //! every finished tile is kept, so it loses no more than a tile per thread.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
-use lueur_integrator::{Film, RenderOutput, RenderSettings, RenderStats, Scene, render_pass};
+use lueur_integrator::{
+    Film, PixelBounds, RenderOutput, RenderSettings, RenderStats, Scene, render_pass_in,
+};
 
 /// Set by SIGINT, SIGTERM or SIGHUP: the current pass stops after the
 /// tiles it finished.
@@ -24,12 +28,12 @@ pub const EXIT_INTERRUPTED: u8 = 130;
 pub fn install_signal_handler() -> anyhow::Result<()> {
     ctrlc::set_handler(|| {
         if SIGNALS.fetch_add(1, Ordering::SeqCst) >= 1 {
-            eprintln!("\nsecond interrupt: exiting without writing");
+            crate::bar::message("second interrupt: exiting without writing");
             crate::output::remove_temporaries();
             std::process::exit(i32::from(EXIT_INTERRUPTED));
         }
         CANCEL.store(true, Ordering::SeqCst);
-        eprintln!("\ninterrupt: writing the tiles rendered so far (again to exit now)");
+        crate::bar::message("interrupt: writing the tiles rendered so far (again to exit now)");
     })?;
     Ok(())
 }
@@ -42,6 +46,9 @@ pub struct Limits {
     pub time: Option<f64>,
     /// Stop once [`Film::relative_error`] is at most this.
     pub target_error: Option<f64>,
+    /// Passes are cut to take about this long (for `--partial-every`,
+    /// which writes the image between passes).
+    pub pass_seconds: Option<f64>,
 }
 
 /// Why a render stopped.
@@ -59,14 +66,16 @@ pub enum Stop {
 }
 
 /// Renders in passes until sample index `end` (`settings.spp`, or a
-/// shard's end), a signal or a limit.
+/// shard's end), a signal or a limit, the pixels `bounds` only.
 ///
 /// Starts from `film` (empty, a resumed checkpoint, or an empty shard that
 /// starts past 0) and calls `after_pass` with the film after every complete
 /// pass (to checkpoint it).
+#[allow(clippy::too_many_arguments)]
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
+    bounds: PixelBounds,
     mut film: Film,
     end: u32,
     limits: Limits,
@@ -75,37 +84,43 @@ pub fn render(
 ) -> anyhow::Result<(RenderOutput, Stop)> {
     let start = Instant::now();
     let mut stats = RenderStats::default();
-    let first = film.samples().start;
-    // pbrt's schedule: the first pass brings the film to 1 spp, each next
-    // one doubles it.
-    let next_end = |film: &Film| {
-        let done = film.spp();
-        first.saturating_add(done.saturating_mul(2).max(1)).min(end)
-    };
     if film.samples().end >= end {
         return Ok((RenderOutput { film, stats }, Stop::Complete));
     }
     let resumed_at = film.spp();
-    let mut until = next_end(&film);
+    // pbrt's schedule: the first pass brings the film to 1 spp, each next
+    // one doubles it.
+    let mut until = film.samples().end + 1;
     loop {
-        let pass = render_pass(scene, settings, &mut film, until, &CANCEL, progress)?;
+        let pass_start = Instant::now();
+        let pass_spp = f64::from(until - film.samples().end);
+        let pass = render_pass_in(scene, settings, bounds, &mut film, until, &CANCEL, progress)?;
         stats.merge(&pass.stats);
         if !pass.complete {
             return Ok((RenderOutput { film, stats }, Stop::Interrupted));
         }
+        let pass_secs = pass_start.elapsed().as_secs_f64();
         after_pass(&film)?;
         if film.samples().end >= end {
             return Ok((RenderOutput { film, stats }, Stop::Complete));
         }
         let done = film.spp();
-        let next = next_end(&film);
+        let elapsed = start.elapsed().as_secs_f64();
+        // Seconds per spp: the render's average, or the last pass's if that
+        // was slower (what the next pass is likeliest to cost).
+        let per_spp = (elapsed / f64::from(done - resumed_at)).max(pass_secs / pass_spp);
+        let mut size = done.max(1).min(end - film.samples().end);
         if let Some(budget) = limits.time {
-            let elapsed = start.elapsed().as_secs_f64();
-            let per_spp = elapsed / f64::from(done - resumed_at);
-            let more = f64::from(next - film.samples().end);
-            if elapsed + per_spp * more > budget {
+            // The dyadic film takes passes of any size exactly: the last
+            // one is cut to what is left of the budget.
+            let fits = passes_that_fit(budget - elapsed, per_spp);
+            if fits == 0 {
                 return Ok((RenderOutput { film, stats }, Stop::TimeBudget));
             }
+            size = size.min(fits);
+        }
+        if let Some(seconds) = limits.pass_seconds {
+            size = size.min(passes_that_fit(seconds, per_spp).max(1));
         }
         if let Some(target) = limits.target_error {
             let reached = film.relative_error();
@@ -113,6 +128,17 @@ pub fn render(
                 return Ok((RenderOutput { film, stats }, Stop::TargetError(reached)));
             }
         }
-        until = next;
+        until = film.samples().end + size;
     }
+}
+
+/// How many spp at `per_spp` seconds each fit in `seconds`.
+fn passes_that_fit(seconds: f64, per_spp: f64) -> u32 {
+    if !(seconds > 0.0) {
+        return 0;
+    }
+    if !(per_spp > 0.0) {
+        return u32::MAX;
+    }
+    (seconds / per_spp).floor().min(f64::from(u32::MAX)) as u32
 }

@@ -15,18 +15,18 @@ pub fn print_stats(out: &RenderOutput) {
     // Shares of the threads' time: tracing estimated from every 16th ray
     // (timed), the film merge measured, the rest (camera rays, shading,
     // sampling, the point set, scheduling) by difference.
-    let thread_secs = secs * s.threads.max(1) as f64;
+    let threads = s.threads.max(1);
     let tracing = s.rays.camera.tracing_seconds()
         + s.rays.bounce.tracing_seconds()
         + s.rays.shadow.tracing_seconds();
     let film = s.film_time.as_secs_f64();
-    let share = |x: f64| 100.0 * x / thread_secs;
+    let shares = time_shares(secs * threads as f64, tracing, film);
     println!(
-        "time on {} threads: tracing {:.0}%  shading, normals and sampling {:.0}%  film {:.1}%  (tracing timed on 1 ray in {})",
-        s.threads.max(1),
-        share(tracing),
-        share((thread_secs - tracing - film).max(0.0)),
-        share(film),
+        "time on {threads} thread{}: tracing {:.0}%  shading, normals and sampling {:.0}%  film {:.1}%  (tracing timed on 1 ray in {})",
+        if threads == 1 { "" } else { "s" },
+        shares[0],
+        shares[1],
+        shares[2],
         lueur_integrator::TIMED_EVERY,
     );
     for (name, c) in [
@@ -34,7 +34,12 @@ pub fn print_stats(out: &RenderOutput) {
         ("bounce", &s.rays.bounce),
         ("shadow", &s.rays.shadow),
     ] {
-        let rays = c.rays.max(1) as f64;
+        // A strategy that never casts a kind of ray (no shadow rays under
+        // `mixture`) gets no row of zeros.
+        if c.rays == 0 {
+            continue;
+        }
+        let rays = c.rays as f64;
         println!(
             "{name:<7} rays {:>12}  ({:.3} M/s)  steps/ray {:>6.1}  hit {:>5.1}%  miss {:>5.1}%  gave up {:>5.2}%",
             c.rays,
@@ -56,5 +61,39 @@ pub fn print_stats(out: &RenderOutput) {
             line.push_str(&format!("  {label}: {:.1}%", 100.0 * count as f64 / rays));
         }
         println!("{line}");
+    }
+}
+
+/// The shares, in percent, of the threads' time spent tracing, on the rest
+/// (by difference) and merging into the film, as printed (whole percents,
+/// tenths for the film): they add up to 100 and none is negative. Tracing
+/// is estimated from a sample of timed rays, so it can come out above the
+/// time the threads had; the shares are then of the larger total.
+fn time_shares(thread_secs: f64, tracing: f64, film: f64) -> [f64; 3] {
+    let total = thread_secs.max(tracing + film).max(1e-12);
+    let film = (1000.0 * film / total).round() / 10.0;
+    let tracing = (100.0 * tracing / total).round().min(100.0 - film);
+    [tracing, (100.0 - tracing - film).max(0.0), film]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_shares_add_to_100_and_never_exceed_it() {
+        for (threads, tracing, film) in [
+            (1.0, 1.19, 0.0),
+            (1.0, 0.5, 0.25),
+            (2.0, 0.0, 0.0),
+            (1.0, 0.3333, 0.3333),
+            (1.0, 0.996, 0.004),
+        ] {
+            let s = time_shares(threads, tracing, film);
+            let sum: f64 = s.iter().sum();
+            assert!((sum - 100.0).abs() < 1e-9, "{s:?}");
+            assert!(s.iter().all(|&x| (0.0..=100.0).contains(&x)), "{s:?}");
+        }
+        assert_eq!(time_shares(1.0, 1.19, 0.0), [100.0, 0.0, 0.0]);
     }
 }

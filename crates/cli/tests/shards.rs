@@ -72,12 +72,18 @@ fn shards_merge_into_the_bit_identical_render() {
     );
     assert!(read(d, "whole.exr") == read(d, "merged.exr"));
 
-    // Two shards merged and saved, then resumed past them.
+    // Two shards of the three are refused, naming the missing samples...
+    let o = lueur(&["merge", "a.exr", "b.exr", "-o", "ab.png"], d);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("missing 13..24"), "{}", stderr(&o));
+    assert!(!d.join("ab.png").exists());
+    // ... unless asked for: merged and saved, then resumed past them.
     let o = lueur(
         &[
             "merge",
             "a.exr",
             "b.exr",
+            "--allow-partial",
             "-o",
             "ab.png",
             "--checkpoint",
@@ -222,7 +228,17 @@ fn bad_shards_are_refused_with_the_files_named() {
         &["merge", "s8.exr", "t.exr", "-o", "m.png"],
         "different settings",
     );
-    let o = lueur(&["merge", "s16.exr", "t.exr", "-o", "ok.png"], d);
+    let o = lueur(
+        &[
+            "merge",
+            "s16.exr",
+            "t.exr",
+            "--allow-partial",
+            "-o",
+            "ok.png",
+        ],
+        d,
+    );
     assert!(o.status.success(), "{}", stderr(&o));
 }
 

@@ -53,7 +53,10 @@ mod strategy;
 pub use camera::Camera;
 pub use film::{Film, FilmError, PixelStats, dyadic_blocks, is_dyadic};
 pub use path::RayCounters;
-pub use render::{Pass, RenderOutput, RenderSettings, RenderStats, render, render_pass};
+pub use render::{
+    Pass, PixelBounds, RenderOutput, RenderSettings, RenderStats, render, render_pass,
+    render_pass_in,
+};
 pub use scene::{
     Hit, Light, Marching, Object, QuadSampling, STEP_BUCKETS, Scene, TIMED_EVERY, TraceCounters,
 };

@@ -226,11 +226,73 @@ pub fn render_pass(
     cancel: &AtomicBool,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<Pass, RenderError> {
+    let whole = PixelBounds::whole(settings.width, settings.height);
+    render_pass_in(scene, settings, whole, film, until, cancel, progress)
+}
+
+/// A rectangle of the image's pixels: columns `x0..x1`, rows `y0..y1`
+/// (pbrt-v4's pixel bounds), row 0 at the top.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelBounds {
+    /// First column.
+    pub x0: u32,
+    /// Column after the last.
+    pub x1: u32,
+    /// First row.
+    pub y0: u32,
+    /// Row after the last.
+    pub y1: u32,
+}
+
+impl PixelBounds {
+    /// Every pixel of a `width` x `height` image.
+    pub fn whole(width: u32, height: u32) -> PixelBounds {
+        PixelBounds {
+            x0: 0,
+            x1: width,
+            y0: 0,
+            y1: height,
+        }
+    }
+
+    /// Columns covered.
+    pub fn width(&self) -> u32 {
+        self.x1.saturating_sub(self.x0)
+    }
+
+    /// Rows covered.
+    pub fn height(&self) -> u32 {
+        self.y1.saturating_sub(self.y0)
+    }
+}
+
+/// [`render_pass`] over the pixels `bounds` of the image only, into a film
+/// of their size (a crop): each pixel is bit-identical to the same pixel
+/// of the whole image's film, since the sampler and the camera see the
+/// whole image's pixel coordinates and resolution.
+pub fn render_pass_in(
+    scene: &Scene,
+    settings: &RenderSettings,
+    bounds: PixelBounds,
+    film: &mut Film,
+    until: u32,
+    cancel: &AtomicBool,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Pass, RenderError> {
     settings.validate()?;
-    let (w, h) = (settings.width, settings.height);
+    if bounds.width() == 0
+        || bounds.height() == 0
+        || bounds.x1 > settings.width
+        || bounds.y1 > settings.height
+    {
+        return Err(RenderError::InvalidSetting(
+            "the pixel bounds must be a non-empty part of the image",
+        ));
+    }
+    let (w, h) = (bounds.width(), bounds.height());
     if film.width() != w || film.height() != h {
         return Err(RenderError::InvalidSetting(
-            "the film's size differs from the settings'",
+            "the film's size differs from the pixel bounds'",
         ));
     }
     if film.unfinished_pass().is_some() {
@@ -262,7 +324,7 @@ pub fn render_pass(
     let results: Vec<Option<TileCost>> = tiles
         .par_iter()
         .map(|&origin| {
-            let r = render_tile(&estimator, origin, plan.pass_blocks(), cancel)?;
+            let r = render_tile(&estimator, bounds, origin, plan.pass_blocks(), cancel)?;
             // Checked again so that no tile commits after the signal has
             // been seen: what an interrupt writes is what was there then.
             if cancel.load(Ordering::Relaxed) {
@@ -319,9 +381,10 @@ struct TileCost {
     film_time: Duration,
 }
 
-/// `None` when cancelled.
+/// The tile at `origin` of the film of `bounds`; `None` when cancelled.
 fn render_tile(
     estimator: &Estimator<'_>,
+    bounds: PixelBounds,
     origin: UVec2,
     pass_blocks: &[Range<u32>],
     cancel: &AtomicBool,
@@ -329,7 +392,12 @@ fn render_tile(
     let samples = pass_blocks[0].start..pass_blocks[pass_blocks.len() - 1].end;
     let settings = estimator.settings;
     let (w, h) = (settings.width, settings.height);
-    let (tw, th) = ((w - origin.x).min(TILE), (h - origin.y).min(TILE));
+    let (tw, th) = (
+        (bounds.width() - origin.x).min(TILE),
+        (bounds.height() - origin.y).min(TILE),
+    );
+    // Pixels are named by their place in the whole image.
+    let origin = origin + UVec2::new(bounds.x0, bounds.y0);
     let mut sampler = Sampler::for_image(settings.sampler, settings.seed, [w, h], settings.spp);
     let mut counters = RayCounters::default();
     let mut dropped = 0u64;

@@ -38,6 +38,7 @@
 #![deny(missing_docs)]
 
 mod error;
+mod overrides;
 mod parse;
 
 use std::collections::HashMap;
@@ -53,7 +54,7 @@ use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
 pub use error::SceneFileError;
-use parse::{Check, Result, Source, Table, as_table};
+use parse::{Check, Result, Source, Table, as_table, did_you_mean};
 
 /// A parsed scene file: what to render and how.
 #[derive(Clone, Debug)]
@@ -70,11 +71,30 @@ const MAX_SHAPE_DEPTH: usize = 64;
 
 /// Parses a scene from `text`; `file` is the name used in error messages.
 pub fn parse_scene(text: &str, file: &str) -> std::result::Result<SceneFile, SceneFileError> {
-    let src = Source { file, text };
-    let root = DeTable::parse(text).map_err(|e| {
+    parse_scene_with(text, file, &[])
+}
+
+/// Parses a scene from `text` with `overrides` applied, each `KEY=VALUE`
+/// with a dotted key path (`camera.vfov=30`, `lights[0].radiance=[1,1,1]`)
+/// and a TOML value, as the file would set it: the values go through the
+/// file's own checks, and an error in one names it as `--set`, with its
+/// key and a caret.
+pub fn parse_scene_with(
+    text: &str,
+    file: &str,
+    overrides: &[&str],
+) -> std::result::Result<SceneFile, SceneFileError> {
+    let src = Source {
+        file,
+        text,
+        overrides,
+        bases: overrides::bases(text, overrides),
+    };
+    let mut root = DeTable::parse(text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
         src.error(span, "", format!("invalid TOML: {}", e.message().trim()))
     })?;
+    overrides::apply(&src, root.get_mut(), overrides)?;
     let top = Table::new(root.get_ref(), root.span(), String::new());
     top.deny_unknown(
         &src,
@@ -217,7 +237,8 @@ fn parse_render(
                 span,
                 &render.key_path("strategy"),
                 format!(
-                    "unknown strategy `{name}`; expected one of {}",
+                    "unknown strategy `{name}`{}; expected one of {}",
+                    did_you_mean(name, all.iter().copied()),
                     all.join(", ")
                 ),
             )
@@ -230,7 +251,8 @@ fn parse_render(
                 span,
                 &render.key_path("sampler"),
                 format!(
-                    "unknown sampler `{name}`; expected one of {}",
+                    "unknown sampler `{name}`{}; expected one of {}",
+                    did_you_mean(name, all.iter().copied()),
                     all.join(", ")
                 ),
             )
@@ -263,7 +285,10 @@ fn parse_render(
                 return Err(src.error(
                     span,
                     &render.key_path("quad_sampling"),
-                    format!("unknown quad sampling `{name}`; expected `area` or `solid-angle`"),
+                    format!(
+                        "unknown quad sampling `{name}`{}; expected `area` or `solid-angle`",
+                        did_you_mean(name, ["area", "solid-angle"])
+                    ),
                 ));
             }
         };
@@ -311,7 +336,10 @@ fn parse_material(src: &Source<'_>, t: &Table<'_, '_>) -> Result<Material> {
         other => Err(src.error(
             span,
             &t.key_path("type"),
-            format!("unknown material type `{other}`; expected `lambertian` or `mirror`"),
+            format!(
+                "unknown material type `{other}`{}; expected `lambertian` or `mirror`",
+                did_you_mean(other, ["lambertian", "mirror"])
+            ),
         )),
     }
 }
@@ -359,12 +387,32 @@ fn parse_light(src: &Source<'_>, t: &Table<'_, '_>) -> Result<Light> {
         other => Err(src.error(
             span,
             &t.key_path("type"),
-            format!("unknown light type `{other}`; expected `sphere`, `quad` or `directional`"),
+            format!(
+                "unknown light type `{other}`{}; expected `sphere`, `quad` or `directional`",
+                did_you_mean(other, ["sphere", "quad", "directional"])
+            ),
         )),
     }
 }
 
 const TRANSFORM_KEYS: [&str; 3] = ["translate", "rotate", "scale"];
+
+const SHAPE_TYPES: [&str; 14] = [
+    "sphere",
+    "box",
+    "round_box",
+    "plane",
+    "torus",
+    "capped_cylinder",
+    "capsule",
+    "death_star",
+    "union",
+    "intersection",
+    "difference",
+    "smooth_union",
+    "smooth_intersection",
+    "smooth_difference",
+];
 
 fn parse_shape(
     src: &Source<'_>,
@@ -540,9 +588,9 @@ fn parse_shape(
                 span,
                 &t.key_path("type"),
                 format!(
-                    "unknown shape type `{other}`; expected one of sphere, box, round_box, plane, torus, \
-                     capped_cylinder, capsule, death_star, union, intersection, difference, \
-                     smooth_union, smooth_intersection, smooth_difference"
+                    "unknown shape type `{other}`{}; expected one of {}",
+                    did_you_mean(other, SHAPE_TYPES),
+                    SHAPE_TYPES.join(", ")
                 ),
             ));
         }
@@ -607,5 +655,7 @@ fn array_of_tables<'a, 'i>(
         .collect()
 }
 
+#[cfg(test)]
+mod overrides_tests;
 #[cfg(test)]
 mod tests;

@@ -8,10 +8,15 @@ use toml::de::{DeTable, DeValue};
 
 use crate::SceneFileError;
 
-/// The source text and its name, for errors.
+/// The source text and its name, for errors; and the command line's
+/// overrides, whose values' spans lie past the text (see
+/// [`crate::overrides`]).
 pub(crate) struct Source<'s> {
     pub file: &'s str,
     pub text: &'s str,
+    pub overrides: &'s [&'s str],
+    /// Where each override's spans start.
+    pub bases: Vec<usize>,
 }
 
 impl Source<'_> {
@@ -21,8 +26,60 @@ impl Source<'_> {
         key: &str,
         message: impl Into<String>,
     ) -> SceneFileError {
-        SceneFileError::new(self.file, self.text, span, key, message.into())
+        match self.which_override(span.start) {
+            Some(i) => {
+                let base = self.bases[i];
+                SceneFileError::new(
+                    crate::overrides::LABEL,
+                    self.overrides[i],
+                    span.start - base..span.end.saturating_sub(base),
+                    key,
+                    message.into(),
+                )
+            }
+            None => SceneFileError::new(self.file, self.text, span, key, message.into()),
+        }
     }
+
+    /// The override whose text `at` lies in, if it lies past the file's.
+    fn which_override(&self, at: usize) -> Option<usize> {
+        if at <= self.text.len() {
+            return None;
+        }
+        self.bases.iter().rposition(|&b| b <= at)
+    }
+
+    /// Where the spans of override `i` start.
+    pub fn override_base(&self, i: usize) -> usize {
+        self.bases[i]
+    }
+
+    /// The text a span covers, in the file or an override.
+    pub fn snippet(&self, span: Range<usize>) -> &str {
+        let (text, span) = match self.which_override(span.start) {
+            Some(i) => {
+                let b = self.bases[i];
+                (
+                    self.overrides[i],
+                    span.start - b..span.end.saturating_sub(b),
+                )
+            }
+            None => (self.text, span),
+        };
+        text.get(span).unwrap_or("")
+    }
+}
+
+/// " (did you mean `x`?)" when one of `choices` is a likely spelling of
+/// `name` (at most a third of its letters off, two at least), else "".
+pub(crate) fn did_you_mean<'c>(name: &str, choices: impl IntoIterator<Item = &'c str>) -> String {
+    let limit = (name.chars().count() / 3).max(2);
+    choices
+        .into_iter()
+        .map(|c| (strsim::damerau_levenshtein(name, c), c))
+        .filter(|&(d, _)| d <= limit)
+        .min_by_key(|&(d, _)| d)
+        .map_or_else(String::new, |(_, c)| format!(" (did you mean `{c}`?)"))
 }
 
 /// A table being read, with the dotted path that leads to it.
@@ -69,7 +126,10 @@ impl<'a, 'i> Table<'a, 'i> {
             return Err(src.error(
                 k.span(),
                 &self.key_path(name),
-                format!("unknown key `{name}`; expected one of {expected}"),
+                format!(
+                    "unknown key `{name}`{}; expected one of {expected}",
+                    did_you_mean(name, allowed.iter().copied())
+                ),
             ));
         }
         Ok(())
@@ -267,7 +327,7 @@ fn number(src: &Source<'_>, v: &Spanned<DeValue<'_>>, path: &str) -> Result<f32>
             path,
             format!(
                 "must be a finite number (within f32 range), got {}",
-                &src.text[v.span()]
+                src.snippet(v.span())
             ),
         ));
     }
