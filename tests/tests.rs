@@ -26,3 +26,7 @@ mod degenerate;
 
 // The fast marching against the naive reference: the same images.
 mod marching;
+
+// Error bars against a converged reference, for every randomized sampler:
+// the replicates' variance is the true error.
+mod calibration;

@@ -8,7 +8,9 @@
 //! `lueur-samples-START-END`, with channels `n` (u32, finite samples per
 //! pixel), `mean.R/G/B` and `m2.R/G/B` (f32: mean and sum of squared
 //! deviations, stored exactly, so that continuing merges the very same
-//! numbers). Attributes of every layer record its sample range and what the
+//! numbers). A film of several replicates has one such layer per block and
+//! replicate, `lueur-samples-START-END-rR`, with its replicate in
+//! `lueur.replicate`. Attributes of every layer record its sample range and what the
 //! film is a render *of*: the scene file's full text and the settings that
 //! decide a sample's value. A resume or merge whose scene or settings differ
 //! is refused with a message saying which.
@@ -24,6 +26,7 @@ const ATTR_START: &str = "lueur.samples.start";
 const ATTR_END: &str = "lueur.samples.end";
 const ATTR_SCENE: &str = "lueur.scene";
 const ATTR_SETTINGS: &str = "lueur.settings";
+const ATTR_REPLICATE: &str = "lueur.replicate";
 
 /// What, besides the scene text, must match for samples to add up: every
 /// setting that changes a sample's value. The spp target is not among them,
@@ -37,7 +40,7 @@ pub fn settings_fingerprint(s: &RenderSettings, naive: bool) -> String {
     };
     format!(
         "width={} height={} strategy={} sampler={} seed={} max_depth={} roulette_depth={} max_steps={} \
-         pixel_epsilon={} epsilon={} epsilon_abs={} naive={naive}{spp}",
+         pixel_epsilon={} epsilon={} epsilon_abs={} naive={naive} replicates={}{spp}",
         s.width,
         s.height,
         s.strategy,
@@ -49,6 +52,7 @@ pub fn settings_fingerprint(s: &RenderSettings, naive: bool) -> String {
         s.pixel_epsilon,
         s.epsilon_rel,
         s.epsilon_abs,
+        s.replicate_count(),
     )
 }
 
@@ -68,13 +72,16 @@ fn from_stored((m2b, m2g, m2r, mb, mg, mr, n): StoredPixel) -> PixelStats {
     }
 }
 
-/// A block's pixels as the EXR writer asks for them (one closure type for
-/// every layer).
+/// One replicate of a block's pixels as the EXR writer asks for them (one
+/// closure type for every layer): slot `replicate` of `replicates` per
+/// pixel.
 fn block_pixels(
     px: &[PixelStats],
     width: usize,
+    replicates: usize,
+    replicate: usize,
 ) -> impl Fn(Vec2<usize>) -> StoredPixel + Sync + '_ {
-    move |pos| stored(&px[pos.y() * width + pos.x()])
+    move |pos| stored(&px[(pos.y() * width + pos.x()) * replicates + replicate])
 }
 
 /// Writes `film` to `path` as a checkpoint, atomically (temporary file,
@@ -86,7 +93,11 @@ pub fn save(path: &Path, film: &Film, scene_text: &str, fingerprint: &str) -> Re
     }
     let size = (film.width() as usize, film.height() as usize);
     let mut layers = Vec::new();
-    for (samples, px) in film.blocks()? {
+    let replicates = film.replicates() as usize;
+    for ((samples, px), r) in film
+        .blocks()?
+        .flat_map(|b| (0..replicates).map(move |r| (b.clone(), r)))
+    {
         let channels = SpecificChannels::build()
             .with_channel("m2.B")
             .with_channel("m2.G")
@@ -95,8 +106,11 @@ pub fn save(path: &Path, film: &Film, scene_text: &str, fingerprint: &str) -> Re
             .with_channel("mean.G")
             .with_channel("mean.R")
             .with_channel("n")
-            .with_pixel_fn(block_pixels(px, size.0));
-        let name = format!("{LAYER_PREFIX}{}-{}", samples.start, samples.end);
+            .with_pixel_fn(block_pixels(px, size.0, replicates, r));
+        let mut name = format!("{LAYER_PREFIX}{}-{}", samples.start, samples.end);
+        if replicates > 1 {
+            name += &format!("-r{r}");
+        }
         let mut attributes = LayerAttributes::named(name.as_str());
         let index = |v: u32| i32::try_from(v).context("sample index too large for a checkpoint");
         let other = &mut attributes.other;
@@ -116,6 +130,9 @@ pub fn save(path: &Path, film: &Film, scene_text: &str, fingerprint: &str) -> Re
             Text::from(ATTR_SETTINGS),
             AttributeValue::Text(text(fingerprint)?),
         );
+        if replicates > 1 {
+            other.insert(Text::from(ATTR_REPLICATE), AttributeValue::I32(r as i32));
+        }
         layers.push(Layer::new(
             size,
             attributes,
@@ -167,8 +184,8 @@ pub struct Header {
     pub samples: std::ops::Range<u32>,
     pub scene_text: String,
     pub fingerprint: String,
-    /// Per block, in the file's order.
-    ranges: Vec<std::ops::Range<u32>>,
+    /// Per layer, in the file's order: its block and replicate.
+    ranges: Vec<(std::ops::Range<u32>, u32)>,
     size: (u32, u32),
 }
 
@@ -195,7 +212,11 @@ pub fn read_header(path: &Path) -> Result<Header> {
             Some(AttributeValue::I32(v)) if *v >= 0 => Ok(*v as u32),
             _ => bail!("{name}: missing or bad `{key}`"),
         };
-        ranges.push(index(ATTR_START)?..index(ATTR_END)?);
+        let replicate = match attr(ATTR_REPLICATE) {
+            None => 0,
+            Some(_) => index(ATTR_REPLICATE)?,
+        };
+        ranges.push((index(ATTR_START)?..index(ATTR_END)?, replicate));
         let read_text = |key: &str| match attr(key) {
             Some(AttributeValue::Text(t)) => Ok(t.to_string()),
             _ => bail!("{name}: missing `{key}`"),
@@ -214,8 +235,8 @@ pub fn read_header(path: &Path) -> Result<Header> {
     let (Some((scene_text, fingerprint)), Some(size)) = (about, size) else {
         bail!("{name} is not a lueur checkpoint (no `{LAYER_PREFIX}*` layer)");
     };
-    let start = ranges.iter().map(|r| r.start).min().unwrap_or(0);
-    let end = ranges.iter().map(|r| r.end).max().unwrap_or(0);
+    let start = ranges.iter().map(|r| r.0.start).min().unwrap_or(0);
+    let end = ranges.iter().map(|r| r.0.end).max().unwrap_or(0);
     Ok(Header {
         samples: start..end,
         scene_text,
@@ -254,19 +275,48 @@ pub fn read_film(path: &Path) -> Result<Saved> {
         .from_file(path)
         .with_context(|| format!("cannot read checkpoint {name}"))?;
     // Layers come back in the file's order, the headers'.
-    let mut blocks: Vec<_> = header
+    let layers: Vec<_> = header
         .ranges
         .into_iter()
         .zip(image.layer_data)
         .map(|(samples, layer)| (samples, layer.channel_data.pixels.1))
         .collect();
-    blocks.sort_by_key(|b| b.0.start);
+    let (replicates, blocks) = interleave_replicates(layers)
+        .with_context(|| format!("{name}: inconsistent replicate layers"))?;
     let start = blocks[0].0.start;
-    let film = Film::from_blocks(w, h, start, blocks)
+    let film = Film::from_blocks(w, h, start, replicates, blocks)
         .with_context(|| format!("{name}: inconsistent checkpoint data"))?;
     Ok(Saved {
         film,
         scene_text: header.scene_text,
         fingerprint: header.fingerprint,
     })
+}
+
+type Block = (std::ops::Range<u32>, Vec<PixelStats>);
+
+/// The film's blocks from one layer per (block, replicate): each block's
+/// pixels with their replicates' slots side by side, blocks in order.
+fn interleave_replicates(
+    mut layers: Vec<((std::ops::Range<u32>, u32), Vec<PixelStats>)>,
+) -> Result<(u32, Vec<Block>)> {
+    layers.sort_by_key(|((samples, r), _)| (samples.start, *r));
+    let replicates = layers.iter().map(|((_, r), _)| r + 1).max().unwrap_or(1);
+    let mut blocks = Vec::new();
+    for group in layers.chunks(replicates as usize) {
+        let samples = group[0].0.0.clone();
+        let whole = group.len() == replicates as usize
+            && group
+                .iter()
+                .zip(0..)
+                .all(|(((s, r), _), k)| *s == samples && *r == k);
+        if !whole {
+            bail!("block {samples:?} does not have one layer per replicate 0..{replicates}");
+        }
+        let pixels = (0..group[0].1.len())
+            .flat_map(|i| group.iter().map(move |(_, px)| px[i]))
+            .collect();
+        blocks.push((samples, pixels));
+    }
+    Ok((replicates, blocks))
 }

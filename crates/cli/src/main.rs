@@ -80,6 +80,11 @@ struct RenderArgs {
     /// Which point set feeds the estimator.
     #[arg(long, value_parser = parse_sampler)]
     sampler: Option<SamplerKind>,
+    /// Independent randomizations of the point set whose spread gives each
+    /// pixel's error bar (default: 2 for the randomized QMC samplers, 1 for
+    /// independent sampling; at most --spp).
+    #[arg(long, value_name = "K")]
+    replicates: Option<u32>,
     /// Seed of all random numbers.
     #[arg(long)]
     seed: Option<u64>,
@@ -555,10 +560,22 @@ fn apply_flags(mut s: RenderSettings, a: &RenderArgs) -> Result<RenderSettings> 
     if let Some(v) = a.height {
         s.height = v;
     }
+    if let Some(v) = a.replicates {
+        s.replicates = Some(v);
+    }
     if !a.exposure.is_finite() {
         bail!(BadInput("--exposure must be finite".into()));
     }
-    s.validate().map_err(|e| BadInput(e.to_string()))?;
+    s.validate().map_err(|e| match e {
+        lueur_integrator::RenderError::Replicates(why) => match a.replicates {
+            Some(_) => BadInput(format!("--replicates: {why}")),
+            None => BadInput(format!(
+                "render.replicates of {}: {why} (override it with --replicates)",
+                a.scene.display()
+            )),
+        },
+        e => BadInput(e.to_string()),
+    })?;
     Ok(s)
 }
 

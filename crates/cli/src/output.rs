@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use anyhow::{Context, Result, bail};
-use lueur_integrator::{Film, PixelStats};
+use lueur_integrator::{Film, PixelEstimate};
 
 /// Image formats, chosen by the output's extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -99,7 +99,7 @@ fn write_exr(path: &Path, film: &Film) -> Result<()> {
         .with_channel("variance.G")
         .with_channel("variance.B")
         .with_pixel_fn(|pos: Vec2<usize>| {
-            let p: PixelStats = film.pixel(pos.x() as u32, pos.y() as u32);
+            let p: PixelEstimate = film.pixel(pos.x() as u32, pos.y() as u32);
             let v = p.variance_of_mean();
             (p.mean.x, p.mean.y, p.mean.z, v.x, v.y, v.z)
         });

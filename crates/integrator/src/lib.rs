@@ -47,6 +47,7 @@ mod camera;
 mod film;
 mod path;
 mod render;
+mod replicates;
 mod scene;
 mod strategy;
 
@@ -54,6 +55,7 @@ pub use camera::Camera;
 pub use film::{Film, FilmError, PixelStats, dyadic_blocks, is_dyadic};
 pub use path::RayCounters;
 pub use render::{Pass, RenderOutput, RenderSettings, RenderStats, render, render_pass};
+pub use replicates::{DEFAULT_REPLICATES, PixelEstimate, default_replicates};
 pub use scene::{
     Hit, Light, Marching, Object, QuadSampling, STEP_BUCKETS, Scene, TIMED_EVERY, TraceCounters,
 };
@@ -99,4 +101,8 @@ pub enum RenderError {
     /// Another setting out of its range.
     #[error("{0}")]
     InvalidSetting(&'static str),
+    /// Replicates that are zero, more than the spp, or asked of a sampler
+    /// without randomization.
+    #[error("replicates: {0}")]
+    Replicates(String),
 }
