@@ -6,6 +6,7 @@ mod checkpoint;
 mod output;
 mod points;
 mod progressive;
+mod reached;
 mod stats;
 
 use std::ops::Range;
@@ -426,20 +427,11 @@ fn run_render(args: RenderArgs) -> Result<()> {
     if args.stats {
         stats::print_stats(&output);
     }
-    match stop {
-        progressive::Stop::Complete => {}
-        progressive::Stop::TimeBudget => eprintln!(
-            "time budget of {} s reached: stopped at {} of {} spp",
-            args.time.unwrap_or_default(),
-            output.film.spp(),
-            range.end - range.start
-        ),
-        progressive::Stop::TargetError(e) => eprintln!(
-            "target error reached: relative error {e:.4} at {} of {} spp",
-            output.film.spp(),
-            range.end - range.start
-        ),
-        progressive::Stop::Interrupted => return Err(interrupted().into()),
+    for line in reached::stop_report(stop, &output.film, &limits, range.end - range.start) {
+        eprintln!("{line}");
+    }
+    if stop == progressive::Stop::Interrupted {
+        return Err(interrupted().into());
     }
     Ok(())
 }
