@@ -138,3 +138,70 @@ fn one_replicate_overstates_qmc_error() {
     );
     assert!(c.error_over_variance < 0.8, "{:.3}", c.error_over_variance);
 }
+
+/// `--target-error` stops on the honest estimate: rendering in passes of
+/// 1, 1, 2, 4, ... spp (the CLI's) with the default sampler and stopping at
+/// the first pass whose estimated relative error is at most the target,
+/// the *true* relative error (RMS pixel error against the reference over
+/// the image mean, the estimate's definition) lies between target /
+/// sqrt(2) and the target. Each stop's true error is noisy (an RMS over
+/// 64 pixels) and passes double the spp, so the check is on the mean of 20
+/// seeds' ratios true / target, with a band widened by three standard
+/// errors of that mean, measured from the 20 ratios (99.7% for a normal
+/// mean). With one replicate the estimate overstates the error, the render
+/// stops late, and the ratio falls below the band.
+#[test]
+fn an_error_target_stops_with_the_true_error_near_the_target() {
+    use std::sync::atomic::AtomicBool;
+
+    use lueur::integrator::render_pass;
+
+    let scene = scene();
+    let truth = reference(&scene);
+    let truth_mean = truth
+        .iter()
+        .map(|v| f64::from(v.element_sum()))
+        .sum::<f64>()
+        / (3.0 * truth.len() as f64);
+    let target = 0.03;
+    let never = AtomicBool::new(false);
+    let ratios = |replicates: Option<u32>| -> Vec<f64> {
+        (0..20)
+            .map(|seed| {
+                let s = settings(SamplerKind::SobolXor, replicates, 4096, 100 + seed);
+                let mut film = Film::new(8, 8);
+                loop {
+                    let until = (film.spp() * 2).max(1);
+                    render_pass(&scene, &s, &mut film, until, &never, &|_| {}).unwrap();
+                    if film.relative_error() <= target || until == s.spp {
+                        break;
+                    }
+                }
+                let mse = film
+                    .pixels()
+                    .zip(&truth)
+                    .map(|(p, t)| f64::from((p.mean - *t).length_squared()))
+                    .sum::<f64>()
+                    / (3.0 * truth.len() as f64);
+                mse.sqrt() / truth_mean / target
+            })
+            .collect()
+    };
+    let mean_and_se = |r: &[f64]| {
+        let m = r.iter().sum::<f64>() / r.len() as f64;
+        let var = r.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (r.len() - 1) as f64;
+        (m, (var / r.len() as f64).sqrt())
+    };
+    let (m, se) = mean_and_se(&ratios(None));
+    eprintln!("true error / target at the stop: {m:.3} +- {se:.3}");
+    assert!(
+        m >= std::f64::consts::FRAC_1_SQRT_2 - 3.0 * se && m <= 1.0 + 3.0 * se,
+        "true error at the stop is {m:.3} +- {se:.3} of the target"
+    );
+    let (one, se_one) = mean_and_se(&ratios(Some(1)));
+    eprintln!("with one replicate: {one:.3} +- {se_one:.3}");
+    assert!(
+        one + 3.0 * se_one < std::f64::consts::FRAC_1_SQRT_2,
+        "{one:.3}"
+    );
+}
