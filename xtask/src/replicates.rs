@@ -177,18 +177,10 @@ pub fn run(quick: bool) -> Result<()> {
     }
     write_report(&plan, quick, &table)?;
     // The quick figures (12 pixels, 8 seeds) are too noisy to judge by.
-    if quick {
-        Ok(())
-    } else {
-        check_default(&table)
-    }
+    if quick { Ok(()) } else { check_default(&table) }
 }
 
-fn write_report(
-    plan: &Plan,
-    quick: bool,
-    table: &[(String, Vec<(u32, Row)>)],
-) -> Result<()> {
+fn write_report(plan: &Plan, quick: bool, table: &[(String, Vec<(u32, Row)>)]) -> Result<()> {
     let mut md = String::new();
     writeln!(md, "# Replicates: what the error bars cost\n")?;
     writeln!(

@@ -7,6 +7,7 @@ mod output;
 mod points;
 mod progressive;
 mod reached;
+mod reference;
 mod stats;
 
 use std::ops::Range;
@@ -136,6 +137,14 @@ struct RenderArgs {
     /// where the shard is saved for `lueur merge`; --out is then optional.
     #[arg(long, value_name = "START..END", value_parser = parse_sample_range)]
     sample_range: Option<Range<u32>>,
+    /// A converged image of the same size (EXR): after every pass, print
+    /// the MSE and relative MSE against it beside lueur's own estimate.
+    #[arg(long, value_name = "REF.exr")]
+    reference: Option<PathBuf>,
+    /// With --reference: write one CSV row per pass (spp, seconds, MSE,
+    /// relative MSE, estimated MSE, estimated relative error).
+    #[arg(long, value_name = "FILE.csv", requires = "reference")]
+    reference_out: Option<PathBuf>,
 }
 
 fn parse_sample_range(s: &str) -> Result<Range<u32>, String> {
@@ -310,6 +319,19 @@ fn run_render(args: RenderArgs) -> Result<()> {
         time: positive(args.time, "--time")?,
         target_error: positive(args.target_error, "--target-error")?,
     };
+    let mut reference = args
+        .reference
+        .as_deref()
+        .map(|p| {
+            reference::load(
+                p,
+                settings.width,
+                settings.height,
+                args.reference_out.clone(),
+            )
+        })
+        .transpose()
+        .map_err(|e| BadInput(format!("{e:#}")))?;
     progressive::install_signal_handler()?;
 
     let pixels = u64::from(settings.width) * u64::from(settings.height);
@@ -346,10 +368,24 @@ fn run_render(args: RenderArgs) -> Result<()> {
         None => film.sealed_at(range.end),
     };
     bar.inc(pixels * u64::from(film.spp().min(range.end - range.start)));
-    let mut after_pass = |film: &Film| match &args.checkpoint {
-        Some(path) => checkpoint::save(path, film, &text, &fingerprint)
-            .with_context(|| format!("cannot write checkpoint {}", path.display())),
-        None => Ok(()),
+    let mut after_pass = |film: &Film| {
+        if let Some(r) = reference.as_mut() {
+            let e = r.after_pass(film)?;
+            bar.suspend(|| {
+                eprintln!(
+                    "{} spp: MSE {:.4e} against the reference, estimated {:.4e}; relative MSE {:.4e}",
+                    film.spp(),
+                    e.mse,
+                    e.estimated_mse,
+                    e.rel_mse
+                )
+            });
+        }
+        match &args.checkpoint {
+            Some(path) => checkpoint::save(path, film, &text, &fingerprint)
+                .with_context(|| format!("cannot write checkpoint {}", path.display())),
+            None => Ok(()),
+        }
     };
     let end = range.end;
     let run = || {
