@@ -6,6 +6,7 @@ mod checkpoint;
 mod output;
 mod points;
 mod progressive;
+mod provenance;
 mod reached;
 mod reference;
 mod stats;
@@ -425,7 +426,15 @@ fn run_render(args: RenderArgs) -> Result<()> {
     }
 
     if let (Some(out), Some(format)) = (&out, format) {
-        output::write_image(out, format, &output.film, args.exposure)
+        let provenance = provenance::of_render(
+            &file,
+            &text,
+            &settings,
+            output.film.samples(),
+            output.stats.elapsed.as_secs_f64(),
+            output.film.relative_error(),
+        );
+        output::write_image(out, format, &output.film, args.exposure, &provenance)
             .with_context(|| format!("cannot write {}", out.display()))?;
     }
 
@@ -541,7 +550,24 @@ fn run_merge(args: MergeArgs) -> Result<()> {
         film = Some(merged);
     }
     let film = film.expect("clap requires one shard");
-    output::write_image(&args.out, format, &film, args.exposure)
+    let provenance = provenance::Provenance(vec![
+        ("lueur.version".into(), env!("CARGO_PKG_VERSION").into()),
+        (
+            "lueur.scene_hash".into(),
+            provenance::text_hash(&scene_text),
+        ),
+        (
+            "lueur.samples".into(),
+            format!("{}..{}", film.samples().start, film.samples().end),
+        ),
+        ("lueur.merged_shards".into(), count.to_string()),
+        ("lueur.settings".into(), fingerprint.clone()),
+        (
+            "lueur.relative_error".into(),
+            format!("{:.6}", film.relative_error()),
+        ),
+    ]);
+    output::write_image(&args.out, format, &film, args.exposure, &provenance)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
     if let Some(path) = &args.checkpoint {
         checkpoint::save(path, &film, &scene_text, &fingerprint)

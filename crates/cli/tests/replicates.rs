@@ -179,3 +179,104 @@ fn bad_references_exit_2_before_rendering() {
         assert!(!dir.path().join("x.png").exists());
     }
 }
+
+/// The `lueur.*` attributes of an EXR's first layer.
+fn exr_provenance(path: &Path) -> std::collections::BTreeMap<String, String> {
+    use exr::meta::attribute::AttributeValue;
+    let meta = exr::meta::MetaData::read_from_file(path, false).unwrap();
+    meta.headers[0]
+        .own_attributes
+        .other
+        .iter()
+        .filter_map(|(k, v)| match v {
+            AttributeValue::Text(t) => Some((k.to_string(), t.to_string())),
+            _ => None,
+        })
+        .filter(|(k, _)| k.starts_with("lueur."))
+        .collect()
+}
+
+fn png_provenance(path: &Path) -> std::collections::BTreeMap<String, String> {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let reader = decoder.read_info().unwrap();
+    reader
+        .info()
+        .uncompressed_latin1_text
+        .iter()
+        .map(|t| (t.keyword.clone(), t.text.clone()))
+        .collect()
+}
+
+#[test]
+fn every_image_says_how_it_was_made() {
+    let dir = tempfile::tempdir().unwrap();
+    let settings = [
+        "--spp",
+        "8",
+        "--sampler",
+        "cmj",
+        "--replicates",
+        "4",
+        "--seed",
+        "9",
+        "--max-depth",
+        "3",
+        "--strategy",
+        "mixture",
+    ];
+    let text = std::fs::read_to_string(scene("cornell-spheres")).unwrap();
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in text.bytes() {
+        h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+    }
+    let hash = format!("fnv1a64:{h:016x}");
+    for out in ["out.exr", "out.png"] {
+        let o = render(&[&settings[..], &["-o", out]].concat(), dir.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        let path = dir.path().join(out);
+        let p = if out.ends_with(".exr") {
+            exr_provenance(&path)
+        } else {
+            png_provenance(&path)
+        };
+        let get = |k: &str| p.get(&format!("lueur.{k}")).cloned().unwrap_or_default();
+        for (key, value) in [
+            ("version", env!("CARGO_PKG_VERSION")),
+            ("scene", scene("cornell-spheres").as_str()),
+            ("scene_hash", hash.as_str()),
+            ("spp", "8"),
+            ("strategy", "mixture"),
+            ("sampler", "cmj"),
+            ("replicates", "4"),
+            ("seed", "9"),
+            ("max_depth", "3"),
+        ] {
+            assert_eq!(get(key), value, "{out}: lueur.{key} in {p:?}");
+        }
+        assert!(get("render_seconds").parse::<f64>().unwrap() > 0.0, "{p:?}");
+        assert!(get("relative_error").parse::<f64>().unwrap() > 0.0, "{p:?}");
+        assert!(!p.contains_key("lueur.samples"), "not a shard: {p:?}");
+    }
+    let o = render(
+        &[
+            &settings[..],
+            &[
+                "--sample-range",
+                "2..6",
+                "--checkpoint",
+                "c.exr",
+                "-o",
+                "s.exr",
+            ],
+        ]
+        .concat(),
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let p = exr_provenance(&dir.path().join("s.exr"));
+    assert_eq!(p["lueur.samples"], "2..6");
+    assert_eq!(
+        (p["lueur.spp"].as_str(), p["lueur.total_spp"].as_str()),
+        ("4", "8")
+    );
+}
