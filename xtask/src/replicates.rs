@@ -256,7 +256,12 @@ fn write_report(plan: &Plan, quick: bool, table: &[(String, Vec<(u32, Row)>)]) -
          unless the pooled figures calibrate it and not K = 1). Per-pixel tests on the \
          variance layer at K = 2 should use Student's t with one degree of freedom, or \
          ask for more replicates (`--replicates 8`: t with 7). The independent sampler \
-         keeps one replicate: its per-sample variance is valid and less noisy."
+         keeps one replicate: its per-sample variance is valid and less noisy.\n\n\
+         Where the variance CV stays near or above 2 at every K, the scene has \
+         fireflies (rare bright paths through mirrors or small lights): a pixel's \
+         variance is then heavy-tailed across seeds whatever the replicates, and \
+         the replicates' spread is as honest on average (the MSE / variance \
+         column) but not steadier per pixel."
     )?;
     let dir = docs_dir(quick);
     std::fs::create_dir_all(&dir)?;
