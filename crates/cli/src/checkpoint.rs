@@ -294,12 +294,12 @@ pub fn read_film(path: &Path) -> Result<Saved> {
 }
 
 type Block = (std::ops::Range<u32>, Vec<PixelStats>);
+/// A layer as read: its block, its replicate, its pixels.
+type ReplicateLayer = ((std::ops::Range<u32>, u32), Vec<PixelStats>);
 
 /// The film's blocks from one layer per (block, replicate): each block's
 /// pixels with their replicates' slots side by side, blocks in order.
-fn interleave_replicates(
-    mut layers: Vec<((std::ops::Range<u32>, u32), Vec<PixelStats>)>,
-) -> Result<(u32, Vec<Block>)> {
+fn interleave_replicates(mut layers: Vec<ReplicateLayer>) -> Result<(u32, Vec<Block>)> {
     layers.sort_by_key(|((samples, r), _)| (samples.start, *r));
     let replicates = layers.iter().map(|((_, r), _)| r + 1).max().unwrap_or(1);
     let mut blocks = Vec::new();
