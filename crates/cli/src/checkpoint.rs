@@ -302,6 +302,10 @@ type ReplicateLayer = ((std::ops::Range<u32>, u32), Vec<PixelStats>);
 fn interleave_replicates(mut layers: Vec<ReplicateLayer>) -> Result<(u32, Vec<Block>)> {
     layers.sort_by_key(|((samples, r), _)| (samples.start, *r));
     let replicates = layers.iter().map(|((_, r), _)| r + 1).max().unwrap_or(1);
+    if replicates == 1 {
+        // One layer per block: its pixels are the block's, moved, not copied.
+        return Ok((1, layers.into_iter().map(|((s, _), px)| (s, px)).collect()));
+    }
     let mut blocks = Vec::new();
     for group in layers.chunks(replicates as usize) {
         let samples = group[0].0.0.clone();
