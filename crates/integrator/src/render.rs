@@ -39,7 +39,7 @@ pub struct RenderSettings {
     /// Which point set feeds the estimator.
     pub sampler: SamplerKind,
     /// Independent randomizations the samples are dealt into, whose spread
-    /// is the error bar of each pixel (see [`crate::replicates`]); `None`
+    /// is the error bar of each pixel (see `replicates.rs`); `None`
     /// for the sampler's default ([`default_replicates`]).
     pub replicates: Option<u32>,
     /// Maximum number of scattering events (0: emitters seen directly).
