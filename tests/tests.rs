@@ -31,3 +31,7 @@ mod marching;
 // the scene's scale or its distance from the origin; a millimetre sphere's shadow on a
 // ten-kilometre floor.
 mod scale_free;
+
+// Error bars against a converged reference, for every randomized sampler:
+// the replicates' variance is the true error.
+mod calibration;

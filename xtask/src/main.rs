@@ -8,6 +8,7 @@ mod peers;
 mod plot;
 mod pointset_figures;
 mod reference;
+mod replicates;
 mod samplers;
 mod scale;
 mod spectrum;
@@ -87,6 +88,14 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Measure what replicates cost and buy (MSE at equal spp, calibration,
+    /// noise of the per-pixel variance) for K = 1 to 16 on the shipped
+    /// scenes; checks the default; writes docs/REPLICATES.md.
+    Replicates {
+        /// Smaller images, fewer seeds, one sampler, for CI.
+        #[arg(long)]
+        quick: bool,
+    },
     /// Run a command and print its peak resident set in kB (used by
     /// `memory`, one process per measurement).
     #[command(hide = true)]
@@ -105,6 +114,7 @@ fn main() -> Result<()> {
         Command::Memory { quick } => memory::run(quick),
         Command::Peers { quick } => peers::run(quick),
         Command::Scale { quick } => scale::run(quick),
+        Command::Replicates { quick } => replicates::run(quick),
         Command::MemoryProbe { command } => memory::probe(&command),
     }
 }

@@ -187,7 +187,10 @@ pub fn run(quick: bool) -> Result<()> {
         held_to_target: false,
     });
 
-    let film_mb = 28.0 * f64::from(w) * f64::from(h) / 1e6;
+    // The scene's sampler (sobol-xor) deals its samples into the default
+    // number of replicates, each a 28-byte statistic per pixel.
+    let replicates = lueur::integrator::DEFAULT_REPLICATES;
+    let film_mb = 28.0 * f64::from(replicates) * f64::from(w) * f64::from(h) / 1e6;
     let mut table = String::new();
     let mut over = Vec::new();
     writeln!(
@@ -217,7 +220,8 @@ pub fn run(quick: bool) -> Result<()> {
              Peak resident memory of `lueur` (release build) on \
              `{SCENE}` at {w}x{h}, each run in a process of its own \
              (`getrusage`, as `/usr/bin/time -v` reports it). One film image \
-             is 28 bytes per pixel, {film_mb:.0} MB. Regenerate with \
+             is 28 bytes per pixel per replicate; the scene's sampler deals \
+             its samples into {replicates} (the default): {film_mb:.0} MB. Regenerate with \
              `cargo xtask memory` (about 4 minutes on 2 cores); it fails if \
              a render passes {TARGET_MB:.0} MB.\n\n{table}\n\
              The merge holds the merged film, one image per one-bit of its \

@@ -137,6 +137,10 @@ fn measure(plan: &Plan) -> Result<(Table, String)> {
                         spp,
                         strategy: Strategy::Mis,
                         sampler,
+                        // The point sets as point sets: one randomization
+                        // of all the spp. What dealing them into replicates
+                        // for honest error bars costs is docs/REPLICATES.md.
+                        replicates: Some(1),
                         seed: 2000 + u64::from(i),
                         ..file.settings.clone()
                     };
@@ -180,7 +184,9 @@ fn report(plan: &Plan, quick: bool, table: &Table) -> Result<()> {
          averaged over the renders, less the reference's own variance. Slope: least-squares slope of \
          log MSE against log spp (independent sampling: -1). Ratio: independent's MSE over the \
          sampler's at {CHOSEN_AT} spp. Times are medians on this machine, shared with whatever else \
-         ran: compare them within one run only.\n",
+         ran: compare them within one run only. Each render is one randomization of its point set \
+         (`--replicates 1`): the point sets themselves; dealing the samples into replicates for \
+         honest error bars (the default) costs some of the gain, measured in REPLICATES.md.\n",
         if quick { " --quick" } else { "" },
         plan.size,
         plan.size,

@@ -8,7 +8,9 @@
 //! `lueur-samples-START-END`, with channels `n` (u32, finite samples per
 //! pixel), `mean.R/G/B` and `m2.R/G/B` (f32: mean and sum of squared
 //! deviations, stored exactly, so that continuing merges the very same
-//! numbers). Attributes of every layer record its sample range and what the
+//! numbers). A film of several replicates has one such layer per block and
+//! replicate, `lueur-samples-START-END-rR`, with its replicate in
+//! `lueur.replicate`. Attributes of every layer record its sample range and what the
 //! film is a render *of*: the scene file's full text and the settings that
 //! decide a sample's value (`crate::fingerprint`). A resume or merge whose
 //! scene or settings differ is refused with a message saying which.
@@ -24,6 +26,7 @@ const ATTR_START: &str = "lueur.samples.start";
 const ATTR_END: &str = "lueur.samples.end";
 const ATTR_SCENE: &str = "lueur.scene";
 const ATTR_SETTINGS: &str = "lueur.settings";
+const ATTR_REPLICATE: &str = "lueur.replicate";
 
 /// One pixel as a checkpoint stores it, channels in the file's
 /// (alphabetical) order.
@@ -41,13 +44,16 @@ fn from_stored((m2b, m2g, m2r, mb, mg, mr, n): StoredPixel) -> PixelStats {
     }
 }
 
-/// A block's pixels as the EXR writer asks for them (one closure type for
-/// every layer).
+/// One replicate of a block's pixels as the EXR writer asks for them (one
+/// closure type for every layer): slot `replicate` of `replicates` per
+/// pixel.
 fn block_pixels(
     px: &[PixelStats],
     width: usize,
+    replicates: usize,
+    replicate: usize,
 ) -> impl Fn(Vec2<usize>) -> StoredPixel + Sync + '_ {
-    move |pos| stored(&px[pos.y() * width + pos.x()])
+    move |pos| stored(&px[(pos.y() * width + pos.x()) * replicates + replicate])
 }
 
 /// Writes `film` to `path` as a checkpoint, atomically (temporary file,
@@ -59,7 +65,11 @@ pub fn save(path: &Path, film: &Film, scene_text: &str, fingerprint: &str) -> Re
     }
     let size = (film.width() as usize, film.height() as usize);
     let mut layers = Vec::new();
-    for (samples, px) in film.blocks()? {
+    let replicates = film.replicates() as usize;
+    for ((samples, px), r) in film
+        .blocks()?
+        .flat_map(|b| (0..replicates).map(move |r| (b.clone(), r)))
+    {
         let channels = SpecificChannels::build()
             .with_channel("m2.B")
             .with_channel("m2.G")
@@ -68,8 +78,11 @@ pub fn save(path: &Path, film: &Film, scene_text: &str, fingerprint: &str) -> Re
             .with_channel("mean.G")
             .with_channel("mean.R")
             .with_channel("n")
-            .with_pixel_fn(block_pixels(px, size.0));
-        let name = format!("{LAYER_PREFIX}{}-{}", samples.start, samples.end);
+            .with_pixel_fn(block_pixels(px, size.0, replicates, r));
+        let mut name = format!("{LAYER_PREFIX}{}-{}", samples.start, samples.end);
+        if replicates > 1 {
+            name += &format!("-r{r}");
+        }
         let mut attributes = LayerAttributes::named(name.as_str());
         let index = |v: u32| i32::try_from(v).context("sample index too large for a checkpoint");
         let other = &mut attributes.other;
@@ -89,6 +102,9 @@ pub fn save(path: &Path, film: &Film, scene_text: &str, fingerprint: &str) -> Re
             Text::from(ATTR_SETTINGS),
             AttributeValue::Text(text(fingerprint)?),
         );
+        if replicates > 1 {
+            other.insert(Text::from(ATTR_REPLICATE), AttributeValue::I32(r as i32));
+        }
         layers.push(Layer::new(
             size,
             attributes,
@@ -122,8 +138,8 @@ pub struct Header {
     pub samples: std::ops::Range<u32>,
     pub scene_text: String,
     pub fingerprint: String,
-    /// Per block, in the file's order.
-    ranges: Vec<std::ops::Range<u32>>,
+    /// Per layer, in the file's order: its block and replicate.
+    ranges: Vec<(std::ops::Range<u32>, u32)>,
     size: (u32, u32),
 }
 
@@ -150,7 +166,11 @@ pub fn read_header(path: &Path) -> Result<Header> {
             Some(AttributeValue::I32(v)) if *v >= 0 => Ok(*v as u32),
             _ => bail!("{name}: missing or bad `{key}`"),
         };
-        ranges.push(index(ATTR_START)?..index(ATTR_END)?);
+        let replicate = match attr(ATTR_REPLICATE) {
+            None => 0,
+            Some(_) => index(ATTR_REPLICATE)?,
+        };
+        ranges.push((index(ATTR_START)?..index(ATTR_END)?, replicate));
         let read_text = |key: &str| match attr(key) {
             Some(AttributeValue::Text(t)) => Ok(t.to_string()),
             _ => bail!("{name}: missing `{key}`"),
@@ -169,8 +189,8 @@ pub fn read_header(path: &Path) -> Result<Header> {
     let (Some((scene_text, fingerprint)), Some(size)) = (about, size) else {
         bail!("{name} is not a lueur checkpoint (no `{LAYER_PREFIX}*` layer)");
     };
-    let start = ranges.iter().map(|r| r.start).min().unwrap_or(0);
-    let end = ranges.iter().map(|r| r.end).max().unwrap_or(0);
+    let start = ranges.iter().map(|r| r.0.start).min().unwrap_or(0);
+    let end = ranges.iter().map(|r| r.0.end).max().unwrap_or(0);
     Ok(Header {
         samples: start..end,
         scene_text,
@@ -209,15 +229,48 @@ pub fn read_film(path: &Path) -> Result<Saved> {
         .from_file(path)
         .with_context(|| format!("cannot read checkpoint {name}"))?;
     // Layers come back in the file's order, the headers'.
-    let mut blocks: Vec<_> = header
+    let layers: Vec<_> = header
         .ranges
         .into_iter()
         .zip(image.layer_data)
         .map(|(samples, layer)| (samples, layer.channel_data.pixels.1))
         .collect();
-    blocks.sort_by_key(|b| b.0.start);
+    let (replicates, blocks) = interleave_replicates(layers)
+        .with_context(|| format!("{name}: inconsistent replicate layers"))?;
     let start = blocks[0].0.start;
-    let film = Film::from_blocks(w, h, start, blocks)
+    let film = Film::from_blocks(w, h, start, replicates, blocks)
         .with_context(|| format!("{name}: inconsistent checkpoint data"))?;
     Ok(Saved { film })
+}
+
+type Block = (std::ops::Range<u32>, Vec<PixelStats>);
+/// A layer as read: its block, its replicate, its pixels.
+type ReplicateLayer = ((std::ops::Range<u32>, u32), Vec<PixelStats>);
+
+/// The film's blocks from one layer per (block, replicate): each block's
+/// pixels with their replicates' slots side by side, blocks in order.
+fn interleave_replicates(mut layers: Vec<ReplicateLayer>) -> Result<(u32, Vec<Block>)> {
+    layers.sort_by_key(|((samples, r), _)| (samples.start, *r));
+    let replicates = layers.iter().map(|((_, r), _)| r + 1).max().unwrap_or(1);
+    if replicates == 1 {
+        // One layer per block: its pixels are the block's, moved, not copied.
+        return Ok((1, layers.into_iter().map(|((s, _), px)| (s, px)).collect()));
+    }
+    let mut blocks = Vec::new();
+    for group in layers.chunks(replicates as usize) {
+        let samples = group[0].0.0.clone();
+        let whole = group.len() == replicates as usize
+            && group
+                .iter()
+                .zip(0..)
+                .all(|(((s, r), _), k)| *s == samples && *r == k);
+        if !whole {
+            bail!("block {samples:?} does not have one layer per replicate 0..{replicates}");
+        }
+        let pixels = (0..group[0].1.len())
+            .flat_map(|i| group.iter().map(move |(_, px)| px[i]))
+            .collect();
+        blocks.push((samples, pixels));
+    }
+    Ok((replicates, blocks))
 }

@@ -47,6 +47,7 @@ impl Fingerprint {
             ("pixel_epsilon", s.pixel_epsilon.to_string()),
             ("epsilon", s.epsilon_rel.to_string()),
             ("naive", naive.to_string()),
+            ("replicates", s.replicate_count().to_string()),
             ("spp", s.spp.to_string()),
             ("crop", crop),
             ("shard", shard),

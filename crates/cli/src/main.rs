@@ -14,6 +14,9 @@ mod partial;
 mod plot;
 mod points;
 mod progressive;
+mod provenance;
+mod reached;
+mod reference;
 mod resume;
 mod stats;
 mod summary;
@@ -104,6 +107,11 @@ struct RenderArgs {
     /// Which point set feeds the estimator.
     #[arg(long, value_parser = parse_sampler)]
     sampler: Option<SamplerKind>,
+    /// Independent randomizations of the point set whose spread gives each
+    /// pixel's error bar (default: 2 for the randomized QMC samplers, 1 for
+    /// independent sampling; at most --spp).
+    #[arg(long, value_name = "K")]
+    replicates: Option<u32>,
     /// Seed of all random numbers.
     #[arg(long)]
     seed: Option<u64>,
@@ -175,6 +183,14 @@ struct RenderArgs {
     /// between passes), for a viewer that reloads it.
     #[arg(long, value_name = "SECONDS")]
     partial_every: Option<f64>,
+    /// A converged image of the same size (EXR): after every pass, print
+    /// the MSE and relative MSE against it beside lueur's own estimate.
+    #[arg(long, value_name = "REF.exr")]
+    reference: Option<PathBuf>,
+    /// With --reference: write one CSV row per pass (spp, seconds, MSE,
+    /// relative MSE, estimated MSE, estimated relative error).
+    #[arg(long, value_name = "FILE.csv", requires = "reference")]
+    reference_out: Option<PathBuf>,
 }
 
 fn parse_sample_range(s: &str) -> Result<Range<u32>, String> {
@@ -300,6 +316,12 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         settings.height,
     )?;
     let limits = render_limits(&args, out.is_some())?;
+    let mut reference = reference_for(
+        &args,
+        bounds.map_or([settings.width, settings.height], |b| {
+            [b.width(), b.height()]
+        }),
+    )?;
     progressive::install_signal_handler()?;
 
     let whole = PixelBounds::whole(settings.width, settings.height);
@@ -341,12 +363,35 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         )),
         _ => None,
     };
+    let started = std::time::Instant::now();
+    let provenance_of = |film: &Film| {
+        provenance::of_render(
+            &file,
+            &text,
+            &settings,
+            film.samples(),
+            started.elapsed().as_secs_f64(),
+            film.relative_error(),
+        )
+    };
     let mut after_pass = |film: &Film| {
+        if let Some(r) = reference.as_mut() {
+            let e = r.after_pass(film)?;
+            bar::message(&format!(
+                "{} spp: MSE {:.4e} against the reference, estimated {:.4e}; relative MSE {:.4e}",
+                film.spp(),
+                e.mse,
+                e.estimated_mse,
+                e.rel_mse
+            ));
+        }
         if let Some(path) = &args.checkpoint {
             checkpoint::save(path, film, &text, &fingerprint)
                 .with_context(|| format!("cannot write checkpoint {}", path.display()))?;
         }
-        partial.as_mut().map_or(Ok(()), |p| p.after_pass(film))
+        partial
+            .as_mut()
+            .map_or(Ok(()), |p| p.after_pass(film, || provenance_of(film)))
     };
     let end = range.end;
     let run = || {
@@ -388,7 +433,15 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     }
 
     if let (Some(out), Some(format)) = (&out, format) {
-        output::write_image(out, format, &output.film, args.exposure)
+        let provenance = provenance::of_render(
+            &file,
+            &text,
+            &settings,
+            output.film.samples(),
+            output.stats.elapsed.as_secs_f64(),
+            output.film.relative_error(),
+        );
+        output::write_image(out, format, &output.film, args.exposure, &provenance)
             .with_context(|| format!("cannot write {}", out.display()))?;
     }
 
@@ -399,11 +452,25 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         stop,
         out.as_deref(),
         range.end - range.start,
+        &limits,
     );
     if stop == progressive::Stop::Interrupted {
         return Err(interrupted().into());
     }
     Ok(())
+}
+
+/// The converged image `--reference` names, checked against the size of what
+/// is rendered (the crop's, where there is one) before the first sample.
+fn reference_for(
+    args: &RenderArgs,
+    [width, height]: [u32; 2],
+) -> Result<Option<reference::Reference>> {
+    args.reference
+        .as_deref()
+        .map(|p| reference::load(p, width, height, args.reference_out.clone()))
+        .transpose()
+        .map_err(|e| BadInput(format!("{e:#}")).into())
 }
 
 /// The sample indices to render: a shard's (`--sample-range`, which needs
@@ -480,7 +547,24 @@ fn run_merge(args: MergeArgs) -> Result<()> {
         film = Some(merged);
     }
     let film = film.expect("clap requires one shard");
-    output::write_image(&args.out, format, &film, args.exposure)
+    let provenance = provenance::Provenance(vec![
+        ("lueur.version".into(), env!("CARGO_PKG_VERSION").into()),
+        (
+            "lueur.scene_hash".into(),
+            provenance::text_hash(&scene_text),
+        ),
+        (
+            "lueur.samples".into(),
+            format!("{}..{}", film.samples().start, film.samples().end),
+        ),
+        ("lueur.merged_shards".into(), count.to_string()),
+        ("lueur.settings".into(), fingerprint.clone()),
+        (
+            "lueur.relative_error".into(),
+            format!("{:.6}", film.relative_error()),
+        ),
+    ]);
+    output::write_image(&args.out, format, &film, args.exposure, &provenance)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
     if let Some(path) = &args.checkpoint {
         checkpoint::save(path, &film, &scene_text, &fingerprint)
@@ -527,9 +611,21 @@ fn apply_flags(mut s: RenderSettings, a: &RenderArgs) -> Result<RenderSettings> 
     if let Some(v) = a.height {
         s.height = v;
     }
+    if let Some(v) = a.replicates {
+        s.replicates = Some(v);
+    }
     if !a.exposure.is_finite() {
         bail!(BadInput("--exposure must be finite".into()));
     }
-    s.validate().map_err(|e| BadInput(e.to_string()))?;
+    s.validate().map_err(|e| match e {
+        lueur_integrator::RenderError::Replicates(why) => match a.replicates {
+            Some(_) => BadInput(format!("--replicates: {why}")),
+            None => BadInput(format!(
+                "render.replicates of {}: {why} (override it with --replicates)",
+                a.scene.display()
+            )),
+        },
+        e => BadInput(e.to_string()),
+    })?;
     Ok(s)
 }

@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use anyhow::{Context, Result, bail};
-use lueur_integrator::{Film, PixelStats};
+use lueur_integrator::{Film, PixelEstimate};
+
+use crate::provenance::Provenance;
 
 /// Image formats, chosen by the output's extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,11 +36,18 @@ impl Format {
     }
 }
 
-/// Writes the film's mean (and for EXR its variance) to `path`.
-pub fn write_image(path: &Path, format: Format, film: &Film, exposure: f32) -> Result<()> {
+/// Writes the film's mean (and for EXR its variance) to `path`, with
+/// `provenance` in its header (EXR attributes, PNG tEXt chunks).
+pub fn write_image(
+    path: &Path,
+    format: Format,
+    film: &Film,
+    exposure: f32,
+    provenance: &Provenance,
+) -> Result<()> {
     write_atomically(path, |tmp| match format {
-        Format::Png => write_png(tmp, film, exposure),
-        Format::Exr => write_exr(tmp, film),
+        Format::Png => write_png(tmp, film, exposure, provenance),
+        Format::Exr => write_exr(tmp, film, provenance),
     })
 }
 
@@ -80,15 +89,22 @@ pub fn temporary_path(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
-fn write_png(path: &Path, film: &Film, exposure: f32) -> Result<()> {
-    let bytes = film.srgb8(exposure);
-    let img = image::RgbImage::from_raw(film.width(), film.height(), bytes)
-        .context("film size mismatch")?;
-    img.save_with_format(path, image::ImageFormat::Png)?;
+fn write_png(path: &Path, film: &Film, exposure: f32, provenance: &Provenance) -> Result<()> {
+    // Through `png` itself: `image`'s encoder writes no text chunks.
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut encoder = png::Encoder::new(file, film.width(), film.height());
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    for (key, value) in &provenance.0 {
+        encoder.add_text_chunk(key.clone(), value.clone())?;
+    }
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(&film.srgb8(exposure))?;
+    writer.finish()?;
     Ok(())
 }
 
-fn write_exr(path: &Path, film: &Film) -> Result<()> {
+fn write_exr(path: &Path, film: &Film, provenance: &Provenance) -> Result<()> {
     use exr::prelude::*;
     // Pixels are read straight from the film's statistics as the writer
     // asks for them, so a 4K film is not copied into channel images first.
@@ -100,17 +116,19 @@ fn write_exr(path: &Path, film: &Film) -> Result<()> {
         .with_channel("variance.G")
         .with_channel("variance.B")
         .with_pixel_fn(|pos: Vec2<usize>| {
-            let p: PixelStats = film.pixel(pos.x() as u32, pos.y() as u32);
+            let p: PixelEstimate = film.pixel(pos.x() as u32, pos.y() as u32);
             let v = p.variance_of_mean();
             (p.mean.x, p.mean.y, p.mean.z, v.x, v.y, v.z)
         });
     let size = (film.width() as usize, film.height() as usize);
-    let layer = Layer::new(
-        size,
-        LayerAttributes::named("lueur"),
-        Encoding::SMALL_LOSSLESS,
-        channels,
-    );
+    let mut attributes = LayerAttributes::named("lueur");
+    for (key, value) in &provenance.0 {
+        let value = Text::new_or_none(value).context("provenance text is ASCII")?;
+        attributes
+            .other
+            .insert(Text::from(key.as_str()), AttributeValue::Text(value));
+    }
+    let layer = Layer::new(size, attributes, Encoding::SMALL_LOSSLESS, channels);
     Image::from_layer(layer).write().to_file(path)?;
     Ok(())
 }

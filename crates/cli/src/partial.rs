@@ -10,6 +10,7 @@ use anyhow::{Context, Result};
 use lueur_integrator::Film;
 
 use crate::output::{self, Format};
+use crate::provenance::Provenance;
 
 /// When and where the partial images go.
 pub struct Partial {
@@ -35,11 +36,15 @@ impl Partial {
 
     /// Called after every complete pass: writes the image if the interval
     /// has passed since the last write.
-    pub fn after_pass(&mut self, film: &Film) -> Result<()> {
+    pub fn after_pass(
+        &mut self,
+        film: &Film,
+        provenance: impl FnOnce() -> Provenance,
+    ) -> Result<()> {
         if self.last.elapsed() < self.every {
             return Ok(());
         }
-        output::write_image(&self.out, self.format, film, self.exposure)
+        output::write_image(&self.out, self.format, film, self.exposure, &provenance())
             .with_context(|| format!("cannot write {}", self.out.display()))?;
         self.last = Instant::now();
         Ok(())

@@ -6,7 +6,7 @@ use std::path::Path;
 use lueur_integrator::{RenderOutput, RenderSettings};
 
 use crate::RenderArgs;
-use crate::progressive::Stop;
+use crate::progressive::{Limits, Stop};
 
 /// Prints the summary of a render of `samples_asked` spp that stopped on
 /// `stop` (an interrupt's own message is printed by the caller).
@@ -17,6 +17,7 @@ pub fn report(
     stop: Stop,
     out: Option<&Path>,
     samples_asked: u32,
+    limits: &Limits,
 ) {
     let stats = &output.stats;
     let secs = stats.elapsed.as_secs_f64();
@@ -57,22 +58,16 @@ pub fn report(
     if args.stats {
         crate::stats::print_stats(output);
     }
-    match stop {
-        Stop::Complete => {}
-        Stop::TimeBudget => {
-            let budget = args.time.unwrap_or_default();
-            say(format!(
-                "time budget of {budget} s: used {secs:.2} s ({:.0}%), stopped at {} of {} spp",
-                100.0 * secs / budget,
-                output.film.spp(),
-                samples_asked
-            ))
-        }
-        Stop::TargetError(e) => say(format!(
-            "target error reached: relative error {e:.4} at {} of {} spp",
+    if stop == Stop::TimeBudget {
+        let budget = args.time.unwrap_or_default();
+        say(format!(
+            "time budget of {budget} s: used {secs:.2} s ({:.0}%), stopped at {} of {} spp",
+            100.0 * secs / budget,
             output.film.spp(),
             samples_asked
-        )),
-        Stop::Interrupted => {}
+        ));
+    }
+    for line in crate::reached::stop_report(stop, &output.film, limits, samples_asked) {
+        say(line);
     }
 }

@@ -1,5 +1,8 @@
 //! The `lueur` binary as a user meets it: exit codes, messages, files.
 
+mod common;
+
+use common::exr_pixels;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -470,7 +473,7 @@ fn checkpoint_then_resume_equals_one_uninterrupted_render() {
         "--out",
         "resumed.exr",
     ]);
-    let read = |name: &str| std::fs::read(dir.path().join(name)).unwrap();
+    let read = |name: &str| exr_pixels(&dir.path().join(name));
     assert!(
         read("whole.exr") == read("resumed.exr"),
         "resumed render differs from the uninterrupted one"

@@ -26,6 +26,10 @@ use std::sync::Mutex;
 use glam::{UVec2, Vec3};
 use smallvec::SmallVec;
 
+use crate::replicates::PixelEstimate;
+
+mod readout;
+
 /// Mean and variance of one pixel's estimates over a set of samples, per
 /// RGB channel.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -132,52 +136,8 @@ pub fn dyadic_blocks(r: Range<u32>) -> Vec<Range<u32>> {
     blocks
 }
 
-/// Statistics of the dyadic blocks of one pixel's samples, built one sample
-/// at a time: a binary counter whose carries are merges, so that it holds
-/// [`dyadic_blocks`] of the samples pushed so far, with their defined
-/// values. Lives on the stack: 64 blocks cover any range of `u32` indices.
-pub(crate) struct BlockCounter {
-    blocks: [(Range<u32>, PixelStats); 64],
-    len: usize,
-}
-
-impl BlockCounter {
-    pub(crate) fn new() -> BlockCounter {
-        BlockCounter {
-            blocks: std::array::from_fn(|_| (0..0, PixelStats::default())),
-            len: 0,
-        }
-    }
-
-    /// Appends sample `index` (the one after the last pushed).
-    #[inline]
-    pub(crate) fn push(&mut self, index: u32, stats: PixelStats) {
-        let mut block = (index..index + 1, stats);
-        while self.len > 0 {
-            let top = &self.blocks[self.len - 1];
-            if !siblings(&top.0, &block.0) {
-                break;
-            }
-            block = (top.0.start..block.0.end, top.1.merged(block.1));
-            self.len -= 1;
-        }
-        self.blocks[self.len] = block;
-        self.len += 1;
-    }
-
-    /// Forgets every sample, to start the next pixel.
-    pub(crate) fn clear(&mut self) {
-        self.len = 0;
-    }
-
-    /// The blocks, in order.
-    pub(crate) fn blocks(&self) -> &[(Range<u32>, PixelStats)] {
-        &self.blocks[..self.len]
-    }
-}
-
 /// Whether `a` and `b` are the two halves of one dyadic block, `a` first.
-fn siblings(a: &Range<u32>, b: &Range<u32>) -> bool {
+pub(crate) fn siblings(a: &Range<u32>, b: &Range<u32>) -> bool {
     let len = a.end - a.start;
     a.end == b.start
         && b.end - b.start == len
@@ -210,6 +170,9 @@ pub enum FilmError {
          number of samples per pixel"
     )]
     UnfinishedPass(Range<u32>),
+    /// Films, or a film and a pass, with different replicate counts.
+    #[error("a film of {0} replicates cannot take samples dealt into {1}")]
+    Replicates(u32, u32),
     /// A film that merged its blocks into one image on reaching its end
     /// (see [`Film::sealed_at`]).
     #[error(
@@ -247,6 +210,10 @@ pub struct Film {
     height: u32,
     /// First sample index (0 unless the film is a shard).
     start: u32,
+    /// Replicates per pixel (see `replicates.rs`): every image holds
+    /// this many [`PixelStats`] per pixel, pixel-major. Taken from the
+    /// first pass while the film is empty.
+    replicates: u32,
     /// The [`dyadic_blocks`] of `start..end`, in order.
     ranges: Vec<Range<u32>>,
     /// Per block, every pixel's statistics over it. Holds more images than
@@ -354,23 +321,26 @@ pub(crate) struct PassSink<'a> {
     plan: &'a PassPlan,
     width: u32,
     tile: u32,
+    replicates: usize,
     /// Per band of rows, per block from `plan.keep` on, the band's pixels.
     bands: Vec<Mutex<Vec<&'a mut [PixelStats]>>>,
 }
 
 impl PassSink<'_> {
     /// Merges a finished tile in: `blocks[m]` holds the tile's pixels
-    /// (row-major, `size` wide) over the pass's block `m`.
+    /// (row-major, `size` wide, each its replicates' slots) over the
+    /// pass's block `m`. Each slot joins the film's as one pixel does.
     pub(crate) fn commit(&self, origin: UVec2, size: UVec2, blocks: &[Vec<PixelStats>]) {
         let band = origin.y / self.tile;
         let mut images = self.bands[band as usize]
             .lock()
             .unwrap_or_else(|poisoned| poisoned.into_inner());
         let mut pass: SmallVec<[PixelStats; 8]> = SmallVec::new();
+        let k = self.replicates;
         for ty in 0..size.y {
-            for tx in 0..size.x {
-                let in_tile = (ty * size.x + tx) as usize;
-                let i = ((origin.y % self.tile + ty) * self.width + origin.x + tx) as usize;
+            for (tx, r) in (0..size.x).flat_map(|tx| (0..k).map(move |r| (tx, r))) {
+                let in_tile = (ty * size.x + tx) as usize * k + r;
+                let i = ((origin.y % self.tile + ty) * self.width + origin.x + tx) as usize * k + r;
                 pass.clear();
                 pass.extend(blocks.iter().map(|b| b[in_tile]));
                 let keep = self.plan.keep;
@@ -395,6 +365,7 @@ impl Film {
             width,
             height,
             start,
+            replicates: 1,
             ranges: Vec::new(),
             images: Vec::new(),
             unfinished: None,
@@ -439,7 +410,8 @@ impl Film {
     }
 
     /// Each dyadic block of samples with every pixel's statistics over it,
-    /// in order: the film's full state, what a checkpoint saves. Refused
+    /// in order: the film's full state, what a checkpoint saves. A pixel
+    /// is [`Film::replicates`] consecutive slots, one per replicate. Refused
     /// for a film whose last pass was interrupted.
     pub fn blocks(&self) -> Result<impl Iterator<Item = (Range<u32>, &[PixelStats])>, FilmError> {
         self.check_whole()?;
@@ -478,7 +450,8 @@ impl Film {
     }
 
     /// A film from saved blocks (a checkpoint or a shard): each block's
-    /// sample range and its `width * height` pixels, row-major. Refused
+    /// sample range and its `width * height` pixels, row-major, each pixel
+    /// its `replicates` slots (as [`Film::blocks`] gives them). Refused
     /// unless the ranges follow each other and every statistic is valid.
     /// Blocks that are not the maximal dyadic tiling of their range (saved
     /// by hand, say) are merged as they come: the film is still right, but
@@ -487,9 +460,11 @@ impl Film {
         width: u32,
         height: u32,
         start: u32,
+        replicates: u32,
         blocks: Vec<(Range<u32>, Vec<PixelStats>)>,
     ) -> Result<Film, FilmError> {
         let mut film = Film::starting_at(width, height, start);
+        film.replicates = replicates.max(1);
         for (samples, pixels) in blocks {
             film.append(samples, pixels)?;
         }
@@ -500,7 +475,7 @@ impl Film {
     /// pixel's, row-major), merging dyadic siblings as a binary counter
     /// carries (the whole-image form of [`PassPlan::apply`]).
     fn append(&mut self, samples: Range<u32>, pixels: Vec<PixelStats>) -> Result<(), FilmError> {
-        let count = self.width as usize * self.height as usize;
+        let count = self.width as usize * self.height as usize * self.replicates as usize;
         if pixels.len() != count {
             return Err(FilmError::PixelCount(pixels.len(), count));
         }
@@ -547,8 +522,17 @@ impl Film {
 
     /// Prepares a render pass over `samples`: the plan of its merges, and
     /// the images of the blocks it adds (empty until its tiles commit).
-    pub(crate) fn begin_pass(&mut self, samples: Range<u32>) -> Result<PassPlan, FilmError> {
+    pub(crate) fn begin_pass(
+        &mut self,
+        samples: Range<u32>,
+        replicates: u32,
+    ) -> Result<PassPlan, FilmError> {
         self.check_follows(&samples)?;
+        if self.ranges.is_empty() {
+            self.replicates = replicates.max(1);
+        } else if self.replicates != replicates {
+            return Err(FilmError::Replicates(self.replicates, replicates));
+        }
         let pass = dyadic_blocks(samples.clone());
         let mut stack: SmallVec<[(Range<u32>, ()); 8]> =
             self.ranges.iter().map(|r| (r.clone(), ())).collect();
@@ -562,7 +546,7 @@ impl Film {
             after = std::iter::once(self.start..samples.end).collect();
             keep = 0;
         }
-        let count = self.width as usize * self.height as usize;
+        let count = self.width as usize * self.height as usize * self.replicates as usize;
         while self.images.len() < after.len() {
             self.images.push(vec![PixelStats::default(); count]);
         }
@@ -578,7 +562,7 @@ impl Film {
 
     /// Where the tiles of the pass `plan` (of `tile`-sized tiles) commit.
     pub(crate) fn pass_sink<'a>(&'a mut self, plan: &'a PassPlan, tile: u32) -> PassSink<'a> {
-        let band_len = (self.width * tile) as usize;
+        let band_len = (self.width * tile) as usize * self.replicates as usize;
         let bands_count = self.height.div_ceil(tile) as usize;
         let mut bands: Vec<Vec<&mut [PixelStats]>> = (0..bands_count).map(|_| Vec::new()).collect();
         for image in self.images[plan.keep..].iter_mut() {
@@ -590,6 +574,7 @@ impl Film {
             plan,
             width: self.width,
             tile,
+            replicates: self.replicates as usize,
             bands: bands.into_iter().map(Mutex::new).collect(),
         }
     }
@@ -630,12 +615,26 @@ impl Film {
         }
     }
 
-    /// Pixel `i`'s statistics over all its samples: its blocks merged in
-    /// order.
-    fn pixel_at(&self, i: usize) -> PixelStats {
-        (0..self.ranges_of(i).len()).fold(PixelStats::default(), |acc, j| {
-            acc.merged(self.images[j][i])
-        })
+    /// Pixel `i`'s estimate over all its samples: per replicate, its
+    /// blocks merged in order.
+    fn pixel_at(&self, i: usize) -> PixelEstimate {
+        let k = self.replicates as usize;
+        let blocks = self.ranges_of(i).len();
+        let slot = |r: usize| {
+            (0..blocks).fold(PixelStats::default(), |acc, j| {
+                acc.merged(self.images[j][i * k + r])
+            })
+        };
+        if k == 1 {
+            return PixelEstimate::of_replicates(&[slot(0)]);
+        }
+        let slots: SmallVec<[PixelStats; 16]> = (0..k).map(slot).collect();
+        PixelEstimate::of_replicates(&slots)
+    }
+
+    /// Replicates per pixel (see `replicates.rs`).
+    pub fn replicates(&self) -> u32 {
+        self.replicates
     }
 
     /// Merges films of consecutive sample ranges (shards of one render, in
@@ -656,6 +655,11 @@ impl Film {
                     shard.height,
                 ));
             }
+            if film.ranges.is_empty() {
+                film.replicates = shard.replicates;
+            } else if shard.replicates != film.replicates && !shard.ranges.is_empty() {
+                return Err(FilmError::Replicates(film.replicates, shard.replicates));
+            }
             if shard.start != film.samples().end {
                 return Err(FilmError::NotContiguous(film.samples(), shard.samples()));
             }
@@ -664,23 +668,6 @@ impl Film {
             }
         }
         Ok(film)
-    }
-
-    /// Relative standard error of the image: the RMS over pixels and
-    /// channels of each pixel's standard error, divided by the image's mean
-    /// radiance. What `--target-error` stops on; infinite before 2 spp.
-    pub fn relative_error(&self) -> f64 {
-        let (mean, _) = self.image_mean();
-        if self.spp() < 2 || !(mean > 0.0) {
-            return f64::INFINITY;
-        }
-        let n = 3.0 * self.pixels().len() as f64;
-        let var: f64 = self
-            .pixels()
-            .map(|p| p.variance_of_mean().element_sum() as f64)
-            .sum::<f64>()
-            / n;
-        var.sqrt() / mean
     }
 
     /// Width in pixels.
@@ -693,77 +680,23 @@ impl Film {
         self.height
     }
 
-    /// Statistics of pixel (x, y) over all its samples.
-    pub fn pixel(&self, x: u32, y: u32) -> PixelStats {
+    /// Estimate of pixel (x, y) over all its samples.
+    pub fn pixel(&self, x: u32, y: u32) -> PixelEstimate {
         self.pixel_at((y * self.width + x) as usize)
     }
 
     /// Statistics of every pixel over all its samples, row-major, computed
     /// as they are read (its blocks merged in order): looking at a film
     /// never copies it.
-    pub fn pixels(&self) -> impl ExactSizeIterator<Item = PixelStats> + '_ {
+    pub fn pixels(&self) -> impl ExactSizeIterator<Item = PixelEstimate> + '_ {
         (0..self.width as usize * self.height as usize).map(|i| self.pixel_at(i))
-    }
-
-    /// Mean radiance of every pixel, row-major.
-    pub fn mean_image(&self) -> Vec<Vec3> {
-        self.pixels().map(|p| p.mean).collect()
-    }
-
-    /// Variance of the mean of every pixel, row-major.
-    pub fn variance_image(&self) -> Vec<Vec3> {
-        self.pixels().map(|p| p.variance_of_mean()).collect()
-    }
-
-    /// The mean image as 8-bit sRGB (IEC 61966-2-1), clamped, after scaling
-    /// by `2^exposure`: what a PNG shows.
-    pub fn srgb8(&self, exposure: f32) -> Vec<u8> {
-        let gain = exposure.exp2();
-        let encode = |linear: f32| {
-            let c = (linear * gain).clamp(0.0, 1.0);
-            let v = if c <= 0.003_130_8 {
-                12.92 * c
-            } else {
-                1.055 * c.powf(1.0 / 2.4) - 0.055
-            };
-            (v * 255.0 + 0.5) as u8
-        };
-        self.pixels()
-            .flat_map(|p| [encode(p.mean.x), encode(p.mean.y), encode(p.mean.z)])
-            .collect()
-    }
-
-    /// Mean over pixels and channels of the per-sample variance: the noise
-    /// of one sample, the figure the strategies are compared on.
-    pub fn mean_sample_variance(&self) -> f64 {
-        let sum: f64 = self
-            .pixels()
-            .map(|p| p.sample_variance().element_sum() as f64)
-            .sum();
-        sum / (3.0 * self.pixels().len() as f64)
-    }
-
-    /// Mean of the image over pixels and channels, with its standard error
-    /// (pixels are independent, so the variances of their means add).
-    pub fn image_mean(&self) -> (f64, f64) {
-        let n = 3.0 * self.pixels().len() as f64;
-        let mean: f64 = self
-            .pixels()
-            .map(|p| p.mean.element_sum() as f64)
-            .sum::<f64>()
-            / n;
-        let var: f64 = self
-            .pixels()
-            .map(|p| p.variance_of_mean().element_sum() as f64)
-            .sum::<f64>()
-            / (n * n);
-        (mean, var.sqrt())
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::replicates::BlockCounter;
 
     #[test]
     fn welford_matches_two_pass() {
@@ -784,16 +717,15 @@ mod tests {
         let xs: Vec<f32> = (0..37)
             .map(|i| ((i * 7919) % 101) as f32 * 0.37 - 9.0)
             .collect();
-        let mut counter = BlockCounter::new();
+        let mut counter = BlockCounter::new(1);
         for (i, &x) in xs.iter().enumerate() {
             counter.push(i as u32, PixelStats::of_sample(Vec3::splat(x)));
         }
-        let ranges: Vec<_> = counter.blocks().iter().map(|b| b.0.clone()).collect();
+        let ranges: Vec<_> = counter.blocks().map(|b| b.0.clone()).collect();
         assert_eq!(ranges, dyadic_blocks(0..37));
         let s = counter
             .blocks()
-            .iter()
-            .fold(PixelStats::default(), |a, b| a.merged(b.1));
+            .fold(PixelStats::default(), |a, b| a.merged(b.1[0]));
         let mean = xs.iter().map(|&x| f64::from(x)).sum::<f64>() / xs.len() as f64;
         let var = xs
             .iter()
@@ -847,12 +779,12 @@ mod tests {
     fn film_of(samples: Range<u32>, value: impl Fn(u32) -> f32) -> Film {
         let mut film = Film::starting_at(1, 1, samples.start);
         for r in dyadic_blocks(samples) {
-            let mut counter = BlockCounter::new();
+            let mut counter = BlockCounter::new(1);
             for i in r.clone() {
                 counter.push(i, PixelStats::of_sample(Vec3::splat(value(i))));
             }
             for (range, stats) in counter.blocks() {
-                film.append(range.clone(), vec![*stats]).unwrap();
+                film.append(range.clone(), stats.to_vec()).unwrap();
             }
         }
         film

@@ -47,6 +47,7 @@ mod camera;
 mod film;
 mod path;
 mod render;
+mod replicates;
 mod scene;
 mod strategy;
 
@@ -57,6 +58,7 @@ pub use render::{
     Pass, PixelBounds, RenderOutput, RenderSettings, RenderStats, render, render_pass,
     render_pass_in,
 };
+pub use replicates::{DEFAULT_REPLICATES, PixelEstimate, default_replicates};
 pub use scene::{
     Hit, Light, Marching, Object, QuadSampling, STEP_BUCKETS, Scene, TIMED_EVERY, TraceCounters,
 };
@@ -102,4 +104,8 @@ pub enum RenderError {
     /// Another setting out of its range.
     #[error("{0}")]
     InvalidSetting(&'static str),
+    /// Replicates that are zero, more than the spp, or asked of a sampler
+    /// without randomization.
+    #[error("replicates: {0}")]
+    Replicates(String),
 }

@@ -8,8 +8,9 @@ use glam::UVec2;
 use lueur_sampling::{Sampler, SamplerKind};
 use rayon::prelude::*;
 
-use crate::film::{BlockCounter, Film, PixelStats};
+use crate::film::{Film, PixelStats};
 use crate::path::{CAMERA_DIMS, Estimator, March, RayCounters, SampleId, radiance};
+use crate::replicates::{BlockCounter, default_replicates};
 use crate::{RenderError, Scene, Strategy};
 
 /// Side of the square tiles the image is cut into. Small enough that both
@@ -37,6 +38,10 @@ pub struct RenderSettings {
     pub strategy: Strategy,
     /// Which point set feeds the estimator.
     pub sampler: SamplerKind,
+    /// Independent randomizations the samples are dealt into, whose spread
+    /// is the error bar of each pixel (see `replicates.rs`); `None`
+    /// for the sampler's default ([`default_replicates`]).
+    pub replicates: Option<u32>,
     /// Maximum number of scattering events (0: emitters seen directly).
     pub max_depth: u32,
     /// Scattering events after which Russian roulette may end a path (on
@@ -62,6 +67,7 @@ impl Default for RenderSettings {
             spp: 64,
             strategy: Strategy::default(),
             sampler: SamplerKind::default(),
+            replicates: None,
             max_depth: 8,
             roulette_depth: 3,
             seed: 0,
@@ -106,6 +112,9 @@ impl RenderSettings {
         if self.spp > MAX_SPP {
             return Err(RenderError::InvalidSetting("spp must be at most 2^24"));
         }
+        if let Some(k) = self.replicates {
+            self.validate_replicates(k)?;
+        }
         if self.max_steps == 0 {
             return Err(RenderError::InvalidSetting("max_steps must be at least 1"));
         }
@@ -119,6 +128,40 @@ impl RenderSettings {
             if !(v > 0.0 && v.is_finite()) {
                 return Err(RenderError::InvalidSetting(what));
             }
+        }
+        Ok(())
+    }
+}
+
+impl RenderSettings {
+    /// The replicates the render deals its samples into: the settings' or
+    /// the sampler's default.
+    pub fn replicate_count(&self) -> u32 {
+        self.replicates
+            .unwrap_or_else(|| default_replicates(self.sampler, self.spp))
+    }
+
+    fn validate_replicates(&self, k: u32) -> Result<(), RenderError> {
+        if k == 0 {
+            return Err(RenderError::Replicates("must be at least 1, got 0".into()));
+        }
+        if k > self.spp {
+            return Err(RenderError::Replicates(format!(
+                "{k} replicates need at least {k} spp, got {}",
+                self.spp
+            )));
+        }
+        if k > 1 && !self.sampler.is_randomized() {
+            return Err(RenderError::Replicates(format!(
+                "the {} sampler is not randomized: it has no independent replicates \
+                 (use 1, or a randomized sampler such as {}-owen)",
+                self.sampler,
+                if self.sampler == SamplerKind::Halton {
+                    "halton"
+                } else {
+                    "sobol"
+                }
+            )));
         }
         Ok(())
     }
@@ -318,8 +361,12 @@ pub fn render_pass_in(
         .collect();
 
     let plan = film
-        .begin_pass(from..until)
-        .expect("checked: the pass follows a whole film");
+        .begin_pass(from..until, settings.replicate_count())
+        .map_err(|_| {
+            RenderError::InvalidSetting(
+                "the film holds another number of replicates than the settings",
+            )
+        })?;
     let sink = film.pass_sink(&plan, TILE);
     let results: Vec<Option<TileCost>> = tiles
         .par_iter()
@@ -398,12 +445,19 @@ fn render_tile(
     );
     // Pixels are named by their place in the whole image.
     let origin = origin + UVec2::new(bounds.x0, bounds.y0);
-    let mut sampler = Sampler::for_image(settings.sampler, settings.seed, [w, h], settings.spp);
+    let replicates = settings.replicate_count();
+    let mut sampler = Sampler::for_render(
+        settings.sampler,
+        settings.seed,
+        [w, h],
+        settings.spp,
+        replicates,
+    );
     let mut counters = RayCounters::default();
     let mut dropped = 0u64;
     let block_count = pass_blocks.len();
-    let mut blocks = vec![Vec::with_capacity((tw * th) as usize); block_count];
-    let mut counter = BlockCounter::new();
+    let mut blocks = vec![Vec::with_capacity((tw * th * replicates) as usize); block_count];
+    let mut counter = BlockCounter::new(replicates);
     for y in origin.y..origin.y + th {
         for x in origin.x..origin.x + tw {
             if cancel.load(Ordering::Relaxed) {
@@ -426,9 +480,9 @@ fn render_tile(
                 }
                 counter.push(index, PixelStats::of_sample(l));
             }
-            debug_assert_eq!(counter.blocks().len(), block_count);
-            for (block, (_, stats)) in blocks.iter_mut().zip(counter.blocks()) {
-                block.push(*stats);
+            debug_assert_eq!(counter.blocks().count(), block_count);
+            for (block, (_, slots)) in blocks.iter_mut().zip(counter.blocks()) {
+                block.extend_from_slice(slots);
             }
         }
     }

@@ -116,6 +116,13 @@ impl SamplerKind {
         )
     }
 
+    /// Whether the kind is randomized (every kind but the plain Halton and
+    /// Sobol' sequences): only then does a different seed give an
+    /// independent point set, which is what replicates are made of.
+    pub fn is_randomized(&self) -> bool {
+        !matches!(self, SamplerKind::Halton | SamplerKind::Sobol)
+    }
+
     /// The lowercase name used on command lines and in scene files.
     pub fn name(&self) -> &'static str {
         match self {
@@ -176,7 +183,15 @@ pub const DIMENSIONS_PER_SAMPLE: u32 = 65536;
 pub struct Sampler {
     kind: SamplerKind,
     seed: u64,
-    /// Samples per pixel, at least 1: the size of the stratified patterns.
+    /// Independent randomizations the render's samples are dealt into
+    /// (sample `i` is point `i / replicates` of randomization
+    /// `i % replicates`), at least 1.
+    replicates: u32,
+    /// The randomization seed of the current sample's replicate: `seed`
+    /// for replicate 0, hashed from it for the others.
+    replicate_seed: u64,
+    /// Points per replicate, at least 1: the size of the stratified
+    /// patterns (the render's spp over the replicates, rounded up).
     spp: u32,
     /// `ceil(log2(spp))`, for ZSobol's Morton index.
     log2_spp: u32,
@@ -259,6 +274,10 @@ const PERMUTATIONS_4: [[u8; 4]; 24] = [
     [3, 0, 1, 2],
 ];
 
+/// Mixed into the seed of replicates past the first, so that their
+/// randomizations are not those of another seed's replicate 0.
+const REPLICATE_KEY: u64 = 0x7265_706c_6963_6174;
+
 /// The golden-ratio increment `2^64 / phi` of the 1D Kronecker sequence
 /// (Weyl's, the best-spread rank-1 sequence in 1D).
 const GOLDEN_1D: u64 = 0x9e37_79b9_7f4a_7c15;
@@ -284,7 +303,27 @@ impl Sampler {
     /// the Sobol' kinds). ZSobol indexes a 32-bit sequence, so it is meant
     /// for `width * height * spp <= 2^32` (rounded up to powers of 2 and 4).
     pub fn for_image(kind: SamplerKind, seed: u64, resolution: [u32; 2], spp: u32) -> Self {
-        let spp = spp.max(1);
+        Self::for_render(kind, seed, resolution, spp, 1)
+    }
+
+    /// A sampler for a render of `spp` samples per pixel dealt into
+    /// `replicates` independent randomizations (0 counts as 1): sample `i`
+    /// is point `i / replicates` of randomization `i % replicates`, each
+    /// randomization with its own scramble seeds and, for the kinds laid
+    /// out over the spp, its own pattern of `ceil(spp / replicates)`
+    /// points. With one replicate it is [`Sampler::for_image`]. The
+    /// independent kind is the same for every count (its samples are
+    /// independent already); the plain sequences have no randomization
+    /// to replicate, and a renderer refuses more than one for them.
+    pub fn for_render(
+        kind: SamplerKind,
+        seed: u64,
+        resolution: [u32; 2],
+        spp: u32,
+        replicates: u32,
+    ) -> Self {
+        let replicates = replicates.max(1);
+        let spp = spp.max(1).div_ceil(replicates);
         let log2_spp = spp
             .checked_next_power_of_two()
             .map_or(32, |p| p.trailing_zeros());
@@ -293,6 +332,8 @@ impl Sampler {
         let mut sampler = Self {
             kind,
             seed,
+            replicates,
+            replicate_seed: seed,
             spp,
             log2_spp,
             base4_digits,
@@ -310,6 +351,11 @@ impl Sampler {
         self.kind
     }
 
+    /// The randomizations its samples are dealt into.
+    pub fn replicates(&self) -> u32 {
+        self.replicates
+    }
+
     /// The seed this sampler was built with.
     pub fn seed(&self) -> u64 {
         self.seed
@@ -319,8 +365,18 @@ impl Sampler {
     /// of sample `sample_index` of `pixel` (pbrt-v4 `StartPixelSample`).
     pub fn start_pixel_sample(&mut self, pixel: [u32; 2], sample_index: u32, dimension: u32) {
         self.pixel = pixel;
-        self.index = sample_index;
         self.dimension = dimension;
+        if self.replicates > 1 && self.kind != SamplerKind::Independent {
+            let replicate = sample_index % self.replicates;
+            self.index = sample_index / self.replicates;
+            self.replicate_seed = if replicate == 0 {
+                self.seed
+            } else {
+                hash2(self.seed ^ REPLICATE_KEY, u64::from(replicate))
+            };
+        } else {
+            self.index = sample_index;
+        }
         if self.kind == SamplerKind::Independent {
             let key = u64::from(pixel[0]) | (u64::from(pixel[1]) << 32);
             let stream = mix64(key ^ mix64(self.seed.wrapping_add(0x9e37_79b9_7f4a_7c15)));
@@ -367,7 +423,7 @@ impl Sampler {
         let key = u64::from(self.pixel[0]) | (u64::from(self.pixel[1]) << 32);
         let block = self.index / self.spp;
         hash2(
-            hash3(self.seed, key, u64::from(self.dimension)),
+            hash3(self.replicate_seed, key, u64::from(self.dimension)),
             u64::from(block),
         )
     }
@@ -377,7 +433,7 @@ impl Sampler {
     #[inline]
     fn sequence_hash(&self, dimension: u32) -> u64 {
         let key = u64::from(self.pixel[0]) | (u64::from(self.pixel[1]) << 32);
-        hash3(self.seed, key, u64::from(dimension))
+        hash3(self.replicate_seed, key, u64::from(dimension))
     }
 
     /// Dimension `dimension` of the plain or scrambled Halton or Sobol'
@@ -524,7 +580,7 @@ impl Sampler {
     #[inline]
     fn zsobol(&self) -> [u32; 2] {
         let index = self.zsobol_index() as u32;
-        let h = hash2(self.seed, u64::from(self.dimension));
+        let h = hash2(self.replicate_seed, u64::from(self.dimension));
         [
             nested_uniform_scramble(sobol_u32(index, 0), h as u32),
             nested_uniform_scramble(sobol_u32(index, 1), (h >> 32) as u32),
@@ -540,7 +596,7 @@ impl Sampler {
     fn zsobol_index(&self) -> u64 {
         let morton =
             (morton2(self.pixel[0], self.pixel[1]) << self.log2_spp) | u64::from(self.index);
-        let dimension_key = hash2(self.seed, u64::from(self.dimension));
+        let dimension_key = hash2(self.replicate_seed, u64::from(self.dimension));
         let odd = self.log2_spp & 1 == 1;
         let last_digit = u32::from(odd);
         let mut index = 0u64;

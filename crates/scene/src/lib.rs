@@ -218,6 +218,7 @@ fn parse_render(
             "spp",
             "strategy",
             "sampler",
+            "replicates",
             "max_depth",
             "roulette_depth",
             "seed",
@@ -258,6 +259,7 @@ fn parse_render(
             )
         })?;
     }
+    parse_replicates(src, render, settings)?;
     if let Some(d) = render.u32_in(src, "max_depth", 0, 10_000)? {
         settings.max_depth = d;
     }
@@ -293,6 +295,38 @@ fn parse_render(
             }
         };
     }
+    Ok(())
+}
+
+/// `render.replicates`: at least 1, at most the file's spp, and 1 for the
+/// plain (unrandomized) sequences. Read after `spp` and `sampler`.
+fn parse_replicates(
+    src: &Source<'_>,
+    render: &Table<'_, '_>,
+    settings: &mut RenderSettings,
+) -> Result<()> {
+    let Some((k, span)) = render.u64(src, "replicates")? else {
+        return Ok(());
+    };
+    let why = if k == 0 {
+        Some("must be at least 1, got 0".to_string())
+    } else if k > u64::from(settings.spp) {
+        Some(format!(
+            "{k} replicates need at least {k} spp, and `spp` is {}",
+            settings.spp
+        ))
+    } else if k > 1 && !settings.sampler.is_randomized() {
+        Some(format!(
+            "the {} sampler is not randomized: it has no independent replicates (use 1)",
+            settings.sampler
+        ))
+    } else {
+        None
+    };
+    if let Some(why) = why {
+        return Err(src.error(span, &render.key_path("replicates"), why));
+    }
+    settings.replicates = Some(k as u32);
     Ok(())
 }
 

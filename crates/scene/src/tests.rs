@@ -261,3 +261,33 @@ fn deep_nesting_is_refused_not_overflowed() {
     assert!(err.message.contains("recursion"), "{err}");
     assert_eq!(err.line, 20);
 }
+
+#[test]
+fn replicates_are_checked_against_spp_and_sampler() {
+    let with = |extra: &str| format!("strategy = \"mis\"\n{extra}");
+    check(
+        "strategy = \"mis\"",
+        &with("replicates = 0"),
+        8,
+        "render.replicates",
+        "at least 1",
+    );
+    check(
+        "strategy = \"mis\"",
+        &with("replicates = 5"),
+        8,
+        "render.replicates",
+        "at least 5 spp",
+    );
+    check(
+        "strategy = \"mis\"",
+        &with("sampler = \"halton\"\nreplicates = 2"),
+        9,
+        "render.replicates",
+        "not randomized",
+    );
+    let text = BASE.replacen("strategy = \"mis\"", &with("replicates = 4"), 1);
+    let file = parse_scene(&text, "scene.toml").unwrap();
+    assert_eq!(file.settings.replicates, Some(4));
+    assert_eq!(file.settings.replicate_count(), 4);
+}

@@ -429,7 +429,10 @@ fn check(text: &str) -> Result<(), SceneFileError> {
                 out.stats
             );
             for p in out.film.pixels() {
-                assert!(p.mean.is_finite() && p.m2.is_finite(), "pixel {p:?}");
+                assert!(
+                    p.mean.is_finite() && p.variance_of_mean().is_finite(),
+                    "pixel {p:?}"
+                );
                 assert!(p.mean.min_element() >= 0.0, "negative radiance {p:?}");
             }
             assert!(elapsed < TIME_LIMIT);
