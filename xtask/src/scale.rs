@@ -12,7 +12,8 @@ use lueur::integrator::{RenderSettings, Strategy};
 use lueur::sampling::SamplerKind;
 use lueur::scene::parse_scene;
 
-use crate::{docs_dir, render_with_bar};
+use crate::{docs_dir, load_scene, render_with_bar};
+use lueur::integrator::{RenderStats, render};
 
 /// The floor's albedo, the lights' radiance, and where they are (issue 14's scene).
 const ALBEDO: f64 = 0.5;
@@ -272,11 +273,110 @@ pub fn run(quick: bool) -> Result<()> {
         }
         out.push('\n');
     }
+    if !quick {
+        range(&mut out, spp)?;
+    }
+    give_ups(&mut out, quick)?;
     let dir = docs_dir(quick);
     std::fs::create_dir_all(&dir)?;
     let path = dir.join("SCALE.md");
     std::fs::write(&path, &out).with_context(|| format!("writing {}", path.display()))?;
     print!("{out}");
     println!("wrote {}", path.display());
+    Ok(())
+}
+
+/// How far the answer holds: floors far larger than the light's height, and the scene far
+/// from the origin (where f32 positions are coarse), for `cosine` (BSDF sampling only)
+/// and `mis`, sphere light.
+fn range(out: &mut String, spp: u32) -> Result<()> {
+    let _ = writeln!(
+        out,
+        "## Range\n\nThe sphere light's scene beyond the tested range: floors up to 1e7 \
+         times the light's height, and the whole scene moved up to 1e6 from the origin \
+         (along the diagonal; the spacing of f32 positions there is in the second column).\n\n\
+         | scene | f32 spacing | cosine | mis |\n|---|---|---|---|"
+    );
+    let light = LightKind::Sphere;
+    let cases: Vec<(Ground, Frame, String)> = [1e5, 1e6, 1e7]
+        .into_iter()
+        .map(|h| {
+            (
+                Ground::Floor(h),
+                FRAMES[0],
+                format!("floor half-extent {h:e}"),
+            )
+        })
+        .chain([3e4, 1e5, 3e5, 1e6].into_iter().map(|d: f64| {
+            let frame = Frame {
+                scale: 1.0,
+                offset: d / 1.732_050_8,
+                label: "moved",
+            };
+            (Ground::Floor(10.0), frame, format!("floor 10, moved {d:e}"))
+        }))
+        .collect();
+    for (ground, frame, label) in cases {
+        let spacing = f64::from(f32::EPSILON) * (frame.offset.abs() + 1.0);
+        let cells = [Strategy::Cosine, Strategy::Mis]
+            .into_iter()
+            .map(|s| {
+                let m = measure(light, ground, frame, s, spp)?;
+                let rel = (m.mean - light.expected()) / light.expected();
+                Ok(format!("{:+.2}%", 100.0 * rel))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let _ = writeln!(out, "| {label} | {spacing:.1e} | {} |", cells.join(" | "));
+    }
+    out.push('\n');
+    Ok(())
+}
+
+/// What a ray that reaches the step cap outside a solid is taken to be costs this much:
+/// each shipped scene at the default cap against the same render with a cap 64 times
+/// higher (where almost no ray gives up), same seed, so the difference is the give-ups'.
+fn give_ups(out: &mut String, quick: bool) -> Result<()> {
+    let (size, spp) = if quick { (32, 16) } else { (128, 64) };
+    let _ = writeln!(
+        out,
+        "## Give-ups\n\nA ray that reaches the step cap (`max_steps`) outside a solid is \
+         taken as a hit where it stopped (it is crawling along a surface it is about to \
+         meet). Each shipped scene at {size}x{size}, {spp} spp, `mis`, independent samples, \
+         seed 0, at the default cap against a cap 64 times higher; image means over all \
+         channels.\n\n| scene | secondary rays given up | at 64x the cap | image mean | at 64x \
+         the cap | difference |\n|---|---|---|---|---|---|"
+    );
+    for name in ["cornell-spheres", "death-star", "donut-mirrors"] {
+        let file = load_scene(name)?;
+        let settings = RenderSettings {
+            width: size,
+            height: size,
+            spp,
+            strategy: Strategy::Mis,
+            sampler: SamplerKind::Independent,
+            ..file.settings.clone()
+        };
+        let capped = render(&file.scene, &settings, &|_| {})?;
+        let generous = RenderSettings {
+            max_steps: settings.max_steps * 64,
+            ..settings.clone()
+        };
+        let reference = render(&file.scene, &generous, &|_| {})?;
+        let share = |stats: &RenderStats| {
+            let b = &stats.rays.bounce;
+            let s = &stats.rays.shadow;
+            100.0 * (b.gave_up + s.gave_up) as f64 / (b.rays + s.rays).max(1) as f64
+        };
+        let (m, _) = capped.film.image_mean();
+        let (r, _) = reference.film.image_mean();
+        let _ = writeln!(
+            out,
+            "| {name} | {:.3}% | {:.4}% | {m:.5} | {r:.5} | {:+.3}% |",
+            share(&capped.stats),
+            share(&reference.stats),
+            100.0 * (m - r) / r
+        );
+    }
+    out.push('\n');
     Ok(())
 }
