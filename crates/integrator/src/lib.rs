@@ -45,24 +45,28 @@
 
 mod camera;
 mod film;
+mod geometry;
+mod light;
+mod light_sampler;
 mod path;
 mod render;
 mod replicates;
 mod scene;
 mod strategy;
+mod trace;
 
 pub use camera::Camera;
 pub use film::{Film, FilmError, PixelStats, dyadic_blocks, is_dyadic};
+pub use light::{Light, QuadSampling};
 pub use path::RayCounters;
 pub use render::{
     Pass, PixelBounds, RenderOutput, RenderSettings, RenderStats, render, render_pass,
     render_pass_in,
 };
 pub use replicates::{DEFAULT_REPLICATES, PixelEstimate, default_replicates};
-pub use scene::{
-    Hit, Light, Marching, Object, QuadSampling, STEP_BUCKETS, Scene, TIMED_EVERY, TraceCounters,
-};
+pub use scene::{Marching, Object, Scene};
 pub use strategy::Strategy;
+pub use trace::{Hit, STEP_BUCKETS, TIMED_EVERY, TraceCounters};
 
 /// A scene that cannot be rendered as given.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

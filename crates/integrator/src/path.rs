@@ -8,7 +8,7 @@ use lueur_sdf_math::{
     position_rounding,
 };
 
-use crate::scene::{Hit, Light, Marching, Scene, TraceCounters};
+use crate::{Hit, Marching, Scene, TraceCounters};
 use crate::{RenderSettings, Strategy};
 
 /// Sampler dimensions consumed per path vertex, so that each bounce reads
@@ -339,7 +339,7 @@ pub(crate) fn radiance(
                             1.0,
                             previous.bsdf_pdf,
                             1.0,
-                            scene.sky_pdf(previous.n, ray.dir),
+                            scene.emitters().sky_pdf(previous.n, ray.dir),
                         )
                     };
                     radiance += beta * sky * w;
@@ -357,7 +357,9 @@ pub(crate) fn radiance(
                     let w = if previous.full_weight {
                         1.0
                     } else {
-                        let light_pdf = scene.light_pdf(light, previous.p, previous.n, ray.dir);
+                        let light_pdf = scene
+                            .emitters()
+                            .light_pdf(light, previous.p, previous.n, ray.dir);
                         power_heuristic(1.0, previous.bsdf_pdf, 1.0, light_pdf)
                     };
                     radiance += beta * le * w;
@@ -420,11 +422,12 @@ pub(crate) fn radiance(
                         (s.wi, s.weight(n), s.pdf, true)
                     }
                     Strategy::Light => {
-                        let Some((es, _)) = scene.sample_emitter(p, n, u_emitter_choice, u_emitter)
+                        let Some((es, _)) =
+                            scene.emitters().sample(p, n, u_emitter_choice, u_emitter)
                         else {
                             break;
                         };
-                        let pdf = scene.emitter_pdf(p, n, es.wi);
+                        let pdf = scene.emitters().pdf(p, n, es.wi);
                         let f = material.eval(wo, es.wi, n);
                         if !(pdf > 0.0) || f == Vec3::ZERO {
                             break;
@@ -432,9 +435,9 @@ pub(crate) fn radiance(
                         (es.wi, f * n.dot(es.wi).abs() / pdf, pdf, true)
                     }
                     Strategy::Mixture => {
-                        let use_light = scene.has_emitters() && u_mixture >= 0.5;
+                        let use_light = scene.emitters().any() && u_mixture >= 0.5;
                         let wi = if use_light {
-                            match scene.sample_emitter(p, n, u_emitter_choice, u_emitter) {
+                            match scene.emitters().sample(p, n, u_emitter_choice, u_emitter) {
                                 Some((es, _)) => es.wi,
                                 None => break,
                             }
@@ -445,8 +448,8 @@ pub(crate) fn radiance(
                             }
                         };
                         let hemisphere_pdf = material.pdf(wo, wi, n, HemisphereSampling::Uniform);
-                        let pdf = if scene.has_emitters() {
-                            0.5 * hemisphere_pdf + 0.5 * scene.emitter_pdf(p, n, wi)
+                        let pdf = if scene.emitters().any() {
+                            0.5 * hemisphere_pdf + 0.5 * scene.emitters().pdf(p, n, wi)
                         } else {
                             hemisphere_pdf
                         };
@@ -520,12 +523,7 @@ fn directional_light(
 ) -> Vec3 {
     let mut sum = Vec3::ZERO;
     for light in &scene.lights {
-        if let Light::Directional {
-            direction,
-            irradiance,
-        } = *light
-        {
-            let wi = -direction;
+        if let Some((wi, irradiance)) = light.delta_arrival() {
             let cos = n.dot(wi);
             if cos <= 0.0 {
                 continue;
@@ -562,7 +560,7 @@ fn next_event(
     params: &TraceParams,
     counters: &mut RayCounters,
 ) -> Vec3 {
-    let Some((es, light)) = scene.sample_emitter(surface.p, n, u_choice, u) else {
+    let Some((es, light)) = scene.emitters().sample(surface.p, n, u_choice, u) else {
         return Vec3::ZERO;
     };
     let f = material.eval(wo, es.wi, n);
@@ -582,7 +580,7 @@ fn next_event(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::ray_sphere;
+    use crate::light::ray_sphere;
     use lueur_materials::Material;
     use lueur_sdf_math::Sdf;
 
