@@ -7,10 +7,12 @@
 //! variances* with [`RenderStats`]: lueur exists to compare sampling
 //! choices, so every render carries its own error estimate.
 //!
-//! The design decision that shapes the crate: a [`Strategy`] is one `match`
-//! arm in the path loop (`path.rs`), so the five ways of choosing a
-//! direction share everything else (tracing, mirrors, Russian roulette,
-//! directional lights) and differ only where the report says they do.
+//! The design decision that shapes the crate: a [`Strategy`] is one function
+//! from a vertex and its random numbers to a named scatter (`strategy.rs`),
+//! so the five ways of choosing a direction share everything else (tracing,
+//! mirrors, Russian roulette, directional lights) and differ only where the
+//! report says they do; the path loop (`path.rs`) strings the stages
+//! together.
 //!
 //! Contracts: renders are deterministic (same scene, settings and seed give
 //! the same film bit for bit, whatever the thread count); NaN or infinite
@@ -53,6 +55,7 @@ mod render;
 mod replicates;
 mod scene;
 mod strategy;
+mod surface;
 mod trace;
 
 pub use camera::Camera;

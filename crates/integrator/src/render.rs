@@ -9,8 +9,10 @@ use lueur_sampling::{Sampler, SamplerKind};
 use rayon::prelude::*;
 
 use crate::film::{Film, PixelStats};
-use crate::path::{CAMERA_DIMS, Estimator, March, RayCounters, SampleId, radiance};
+use crate::path::{Estimator, RayCounters, SampleId, radiance};
 use crate::replicates::{BlockCounter, default_replicates};
+use crate::strategy::CAMERA_DIMS;
+use crate::surface::March;
 use crate::{RenderError, Scene, Strategy};
 
 /// Side of the square tiles the image is cut into. Small enough that both

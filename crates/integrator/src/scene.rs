@@ -99,7 +99,7 @@ impl Scene {
 
         // The radius of a box around camera, bounded objects and lights:
         // only the far limit follows it (hit thresholds and spawn offsets
-        // are local to each ray and hit, see `path::March`).
+        // are local to each ray and hit, see `surface::March`).
         let mut lo = camera.position();
         let mut hi = lo;
         let mut include = |c: Vec3, r: f32| {
