@@ -60,6 +60,7 @@ mod trace;
 
 pub use camera::Camera;
 pub use film::{Film, FilmError, PixelStats, dyadic_blocks, is_dyadic};
+pub use geometry::Marching;
 pub use light::{Light, QuadSampling};
 pub use path::RayCounters;
 pub use render::{
@@ -67,7 +68,7 @@ pub use render::{
     render_pass_in,
 };
 pub use replicates::{DEFAULT_REPLICATES, PixelEstimate, default_replicates};
-pub use scene::{Marching, Object, Scene};
+pub use scene::{Object, Scene};
 pub use strategy::Strategy;
 pub use trace::{Hit, STEP_BUCKETS, TIMED_EVERY, TraceCounters};
 

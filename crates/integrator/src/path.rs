@@ -89,8 +89,9 @@ pub(crate) fn radiance(
     } = *estimator;
     let lighting = Lighting {
         scene,
-        emitters: scene.emitters(),
+        emitters: scene.emitters(settings.quad_sampling),
         params: march.secondary,
+        marching: march.marching,
     };
     let mut radiance = Vec3::ZERO;
     let mut beta = Vec3::ONE;
@@ -104,7 +105,14 @@ pub(crate) fn radiance(
             &mut counters.bounce
         };
         let maybe_inside = depth == 0 && march.camera_inside || previous.in_solid;
-        let hit = scene.intersect_leaving(&ray, previous.p, &params, kind, maybe_inside);
+        let hit = scene.intersect_leaving(
+            &ray,
+            previous.p,
+            &params,
+            march.marching,
+            kind,
+            maybe_inside,
+        );
         let Some(on_surface) = SurfaceHit::of(hit) else {
             radiance += emission_found(&lighting, &previous, &ray, hit, beta);
             break;

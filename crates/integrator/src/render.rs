@@ -13,7 +13,7 @@ use crate::path::{Estimator, RayCounters, SampleId, radiance};
 use crate::replicates::{BlockCounter, default_replicates};
 use crate::strategy::CAMERA_DIMS;
 use crate::surface::March;
-use crate::{RenderError, Scene, Strategy};
+use crate::{Marching, QuadSampling, RenderError, Scene, Strategy};
 
 /// Side of the square tiles the image is cut into. Small enough that both
 /// cores stay busy to the end, large enough that scheduling is negligible.
@@ -59,6 +59,11 @@ pub struct RenderSettings {
     /// Secondary rays hit when closer than this fraction of the distance
     /// travelled.
     pub epsilon_rel: f32,
+    /// How rays are marched through the objects (both modes find the same
+    /// surfaces; `Naive` is the reference of the speed-ups).
+    pub marching: Marching,
+    /// How quad lights are sampled toward a shading point.
+    pub quad_sampling: QuadSampling,
 }
 
 impl Default for RenderSettings {
@@ -82,6 +87,8 @@ impl Default for RenderSettings {
             // none at a sixteenth: docs/PEERS.md), for no measurable time.
             pixel_epsilon: 0.0625,
             epsilon_rel: 1e-4,
+            marching: Marching::default(),
+            quad_sampling: QuadSampling::default(),
         }
     }
 }

@@ -10,7 +10,7 @@ use lueur_sdf_math::{PreparedSdf, Ray, Sdf};
 use crate::geometry::Geometry;
 use crate::light::valid_rgb;
 use crate::light_sampler::{Emitters, LightSampler};
-use crate::{Camera, Light, QuadSampling, SceneError};
+use crate::{Camera, Light, Marching, QuadSampling, SceneError};
 
 /// One piece of geometry and what it is made of.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,27 +19,6 @@ pub struct Object {
     pub sdf: Sdf,
     /// Index into [`Scene::materials`].
     pub material: usize,
-}
-
-/// How rays are marched through the objects.
-///
-/// Both modes find the same surfaces (tests hold them to it); `Naive` is kept as the
-/// reference every speed-up is measured against, in the same run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Marching {
-    /// Plain Hart sphere tracing on the plain union of the objects: every step evaluates
-    /// every object; normals by central differences.
-    Naive,
-    /// Each ray first clipped against every object's bound (a box, or a half-space for
-    /// planes): objects whose bound the ray never comes within the hit threshold of are left
-    /// out of its march altogether, and the march runs only over the part of the ray some
-    /// bound covers. Then over-relaxed sphere tracing (Keinert et al. 2014) on the union of
-    /// what is left, where an object whose box is farther than the nearest object found so
-    /// far costs one distance to a box, not its own evaluation. The object hit is the one
-    /// the last step found nearest (no second pass over the scene); normals by the
-    /// tetrahedron (4 evaluations, not 6).
-    #[default]
-    Fast,
 }
 
 /// A complete scene, ready to render.
@@ -55,10 +34,6 @@ pub struct Scene {
     pub sky: Option<Vec3>,
     /// The viewpoint.
     pub camera: Camera,
-    /// How quad lights are sampled.
-    pub quad_sampling: QuadSampling,
-    /// How rays are marched through the objects.
-    pub marching: Marching,
     // Derived at construction.
     pub(crate) geometry: Geometry,
     /// The choice among the lights and the sky that light sampling aims at.
@@ -126,8 +101,6 @@ impl Scene {
             lights,
             sky,
             camera,
-            quad_sampling: QuadSampling::default(),
-            marching: Marching::default(),
             geometry,
             light_sampler,
             size,
@@ -142,10 +115,10 @@ impl Scene {
         self.size
     }
 
-    /// The union of all objects as a distance field, evaluated as [`Scene::marching`]
-    /// says (both modes give the same value).
-    pub fn distance(&self, p: Vec3) -> f32 {
-        self.geometry.distance(p, self.marching)
+    /// The union of all objects as a distance field, evaluated as `marching` says (both
+    /// modes give the same value).
+    pub fn distance(&self, p: Vec3, marching: Marching) -> f32 {
+        self.geometry.distance(p, marching)
     }
 
     /// Object `i`'s field as fast marching evaluates it (its transforms folded).
@@ -158,13 +131,14 @@ impl Scene {
         self.geometry.closest_object(p)
     }
 
-    /// The emitters light sampling chooses among, with their pdfs.
-    pub(crate) fn emitters(&self) -> Emitters<'_> {
+    /// The emitters light sampling chooses among, with their pdfs, quads
+    /// sampled as `quad_sampling` says.
+    pub(crate) fn emitters(&self, quad_sampling: QuadSampling) -> Emitters<'_> {
         Emitters {
             lights: &self.lights,
             sky: self.sky,
             sampler: &self.light_sampler,
-            quad_sampling: self.quad_sampling,
+            quad_sampling,
         }
     }
 

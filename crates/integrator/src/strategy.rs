@@ -15,7 +15,7 @@ use lueur_sdf_math::{Ray, TraceParams};
 
 use crate::light_sampler::Emitters;
 use crate::surface::SurfacePoint;
-use crate::{Scene, TraceCounters};
+use crate::{Marching, Scene, TraceCounters};
 
 /// Sampler dimensions consumed per path vertex, so that each bounce reads
 /// the same dimensions whatever happened before (low-discrepancy point sets
@@ -236,13 +236,14 @@ fn weighted(v: &Vertex, wi: Vec3, pdf: f32) -> Option<Scatter> {
     })
 }
 
-/// What shadow rays need: the scene to trace them in, its emitters, and the
-/// marching parameters of secondary rays.
+/// What shadow rays need: the scene to trace them in, its emitters, and how
+/// secondary rays are marched.
 #[derive(Clone, Copy)]
 pub(crate) struct Lighting<'a> {
     pub scene: &'a Scene,
     pub emitters: Emitters<'a>,
     pub params: TraceParams,
+    pub marching: Marching,
 }
 
 impl Lighting<'_> {
@@ -264,10 +265,14 @@ impl Lighting<'_> {
                 continue;
             }
             let ray = Ray::new(v.at.origin, wi);
-            if self
-                .scene
-                .unoccluded(&ray, f32::INFINITY, None, &self.params, shadow)
-            {
+            if self.scene.unoccluded(
+                &ray,
+                f32::INFINITY,
+                None,
+                &self.params,
+                self.marching,
+                shadow,
+            ) {
                 sum += f * irradiance * cos;
             }
         }
@@ -287,10 +292,14 @@ impl Lighting<'_> {
             return Vec3::ZERO;
         }
         let (shadow_ray, distance) = v.at.shadow_ray(es.wi, es.distance);
-        if !self
-            .scene
-            .unoccluded(&shadow_ray, distance, light, &self.params, shadow)
-        {
+        if !self.scene.unoccluded(
+            &shadow_ray,
+            distance,
+            light,
+            &self.params,
+            self.marching,
+            shadow,
+        ) {
             return Vec3::ZERO;
         }
         let bsdf_pdf = v.material.pdf(wo, es.wi, n, MIS_HEMISPHERE);
@@ -423,7 +432,7 @@ mod tests {
 
     /// A sphere light and a quad light above the vertex, apart, facing it;
     /// and a sky if asked.
-    fn scene(sky: bool, quad_sampling: QuadSampling) -> Scene {
+    fn scene(sky: bool) -> Scene {
         let lights = vec![
             Light::Sphere {
                 center: Vec3::new(-2.0, 3.0, 0.5),
@@ -439,9 +448,7 @@ mod tests {
         ];
         let camera = Camera::new(Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0).unwrap();
         let sky = sky.then_some(Vec3::splat(0.5));
-        let mut scene = Scene::new(vec![], vec![], lights, sky, camera).unwrap();
-        scene.quad_sampling = quad_sampling;
-        scene
+        Scene::new(vec![], vec![], lights, sky, camera).unwrap()
     }
 
     /// Draws `sample` `N_SAMPLES` times; every reported pdf must be `pdf` at
@@ -493,8 +500,8 @@ mod tests {
 
     #[test]
     fn uniform_and_cosine_follow_the_pdf_they_report() {
-        let (v, scene) = (vertex(), scene(true, QuadSampling::default()));
-        let emitters = scene.emitters();
+        let (v, scene) = (vertex(), scene(true));
+        let emitters = scene.emitters(QuadSampling::default());
         for (seed, strategy, hemisphere) in [
             (1, Strategy::Uniform, HemisphereSampling::Uniform),
             (2, Strategy::Cosine, HemisphereSampling::Cosine),
@@ -509,8 +516,8 @@ mod tests {
     fn light_follows_the_pdf_it_reports() {
         let v = vertex();
         for (seed, quads) in [(3, QuadSampling::Area), (4, QuadSampling::SolidAngle)] {
-            let scene = scene(true, quads);
-            let emitters = scene.emitters();
+            let scene = scene(true);
+            let emitters = scene.emitters(quads);
             let sample =
                 |u: &VertexSample| scatter(Strategy::Light, &emitters, &v, u).map(reported);
             let pdf = |wi| emitters.pdf(v.at.p, v.at.n, wi);
@@ -522,8 +529,8 @@ mod tests {
     fn mixture_follows_the_pdf_it_reports() {
         let v = vertex();
         for (seed, sky) in [(5, true), (6, false)] {
-            let scene = scene(sky, QuadSampling::SolidAngle);
-            let emitters = scene.emitters();
+            let scene = scene(sky);
+            let emitters = scene.emitters(QuadSampling::SolidAngle);
             let sample =
                 |u: &VertexSample| scatter(Strategy::Mixture, &emitters, &v, u).map(reported);
             let pdf = |wi| mixture_pdf(&emitters, &v, wi);
@@ -538,8 +545,8 @@ mod tests {
     /// against), together distributed as the sum over emitters.
     #[test]
     fn mis_follows_the_pdfs_it_reports() {
-        let (v, scene) = (vertex(), scene(true, QuadSampling::SolidAngle));
-        let emitters = scene.emitters();
+        let (v, scene) = (vertex(), scene(true));
+        let emitters = scene.emitters(QuadSampling::SolidAngle);
         let bsdf = |u: &VertexSample| {
             let s = scatter(Strategy::Mis, &emitters, &v, u)?;
             assert_eq!(

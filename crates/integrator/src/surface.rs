@@ -73,9 +73,9 @@ impl March {
         March {
             camera,
             secondary,
-            camera_inside: scene.distance(scene.camera.position()) < 0.0,
-            central_normals: scene.marching == Marching::Naive,
-            marching: scene.marching,
+            camera_inside: scene.distance(scene.camera.position(), settings.marching) < 0.0,
+            central_normals: settings.marching == Marching::Naive,
+            marching: settings.marching,
         }
     }
 }
@@ -417,7 +417,7 @@ mod tests {
                 let march = March::new(&scene, &RenderSettings::default());
                 let mut counters = crate::TraceCounters::default();
                 let Some(Hit::Surface { t, object: 0, epsilon, .. }) =
-                    scene.intersect(&ray, &march.secondary, &mut counters)
+                    scene.intersect(&ray, &march.secondary, march.marching, &mut counters)
                 else {
                     continue;
                 };

@@ -7,7 +7,7 @@ use glam::Vec3;
 
 use lueur_sdf_math::{DistanceField, Ray, TraceOutcome, TraceParams, sphere_trace};
 
-use crate::scene::Scene;
+use crate::{Marching, Scene};
 
 /// What a ray found first.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -129,9 +129,10 @@ impl Scene {
         &self,
         ray: &Ray,
         params: &TraceParams,
+        marching: Marching,
         counters: &mut TraceCounters,
     ) -> Option<Hit> {
-        self.intersect_ray(ray, ray.origin, params, counters, false)
+        self.intersect_ray(ray, ray.origin, params, marching, counters, false)
     }
 
     /// [`Scene::intersect`] for a ray that may start inside a solid: a
@@ -147,9 +148,10 @@ impl Scene {
         &self,
         ray: &Ray,
         params: &TraceParams,
+        marching: Marching,
         counters: &mut TraceCounters,
     ) -> Option<Hit> {
-        self.intersect_ray(ray, ray.origin, params, counters, true)
+        self.intersect_ray(ray, ray.origin, params, marching, counters, true)
     }
 
     /// [`Scene::intersect`] (or, with `maybe_inside`, [`Scene::intersect_maybe_inside`])
@@ -164,10 +166,11 @@ impl Scene {
         ray: &Ray,
         from: Vec3,
         params: &TraceParams,
+        marching: Marching,
         counters: &mut TraceCounters,
         maybe_inside: bool,
     ) -> Option<Hit> {
-        self.intersect_ray(ray, from, params, counters, maybe_inside)
+        self.intersect_ray(ray, from, params, marching, counters, maybe_inside)
     }
 
     fn intersect_ray(
@@ -175,6 +178,7 @@ impl Scene {
         ray: &Ray,
         from: Vec3,
         params: &TraceParams,
+        marching: Marching,
         counters: &mut TraceCounters,
         maybe_inside: bool,
     ) -> Option<Hit> {
@@ -190,11 +194,12 @@ impl Scene {
         if !self.objects.is_empty() {
             let p = TraceParams { t_max, ..params };
             let start = ray.at(p.t_min);
-            let inside = maybe_inside && self.distance(start) < -p.eps_abs.max(p.eps_rel * p.t_min);
+            let inside = maybe_inside
+                && self.distance(start, marching) < -p.eps_abs.max(p.eps_rel * p.t_min);
             let (outcome, object) = if inside {
                 (sphere_trace(&self.geometry.inside(), ray, &p), None)
             } else {
-                self.geometry.trace(ray, &p, self.marching)
+                self.geometry.trace(ray, &p, marching)
             };
             counters.record(&outcome);
             let (t_hit, gave_up) = match outcome {
@@ -240,6 +245,7 @@ impl Scene {
         distance: f32,
         target: Option<usize>,
         params: &TraceParams,
+        marching: Marching,
         counters: &mut TraceCounters,
     ) -> bool {
         let clock = counters.clock();
@@ -258,7 +264,7 @@ impl Scene {
             }
             let (outcome, _) =
                 self.geometry
-                    .trace(ray, &TraceParams { t_max, ..*params }, self.marching);
+                    .trace(ray, &TraceParams { t_max, ..*params }, marching);
             counters.record(&outcome);
             // A shadow ray that gives up is taken as a hit too (see `intersect_ray`).
             matches!(outcome, TraceOutcome::Miss { .. })
@@ -288,8 +294,8 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Camera;
     use crate::geometry::tests::{crowd, points};
-    use crate::{Camera, Marching};
     use lueur_materials::Material;
 
     /// [`crate::geometry::tests::crowd`] as a scene.
@@ -301,9 +307,7 @@ mod tests {
 
     #[test]
     fn fast_marching_finds_the_naive_hits() {
-        let mut naive = crowd_scene();
-        naive.marching = Marching::Naive;
-        let fast = crowd_scene();
+        let scene = crowd_scene();
         let params = TraceParams {
             t_max: 200.0,
             max_steps: 100_000,
@@ -316,8 +320,8 @@ mod tests {
         for (i, p) in points().enumerate() {
             let origin = Vec3::new(0.0, 0.5, 6.0) + Vec3::Y * (i % 3) as f32;
             let ray = Ray::new(origin, p * 0.1 - origin);
-            let a = naive.intersect(&ray, &params, &mut naive_steps);
-            let b = fast.intersect(&ray, &params, &mut fast_steps);
+            let a = scene.intersect(&ray, &params, Marching::Naive, &mut naive_steps);
+            let b = scene.intersect(&ray, &params, Marching::Fast, &mut fast_steps);
             match (a, b) {
                 (None, None) => {}
                 (

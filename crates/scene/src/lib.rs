@@ -110,7 +110,6 @@ pub fn parse_scene_with(
     )?;
 
     let mut settings = RenderSettings::default();
-    let mut quad_sampling = QuadSampling::default();
     if let Some(image) = top.table(&src, "image")? {
         image.deny_unknown(&src, &["width", "height"])?;
         if let Some(w) = image.u32_in(&src, "width", 1, 65_536)? {
@@ -121,7 +120,7 @@ pub fn parse_scene_with(
         }
     }
     if let Some(render) = top.table(&src, "render")? {
-        parse_render(&src, &render, &mut settings, &mut quad_sampling)?;
+        parse_render(&src, &render, &mut settings)?;
     }
 
     let camera_table = top
@@ -187,7 +186,7 @@ pub fn parse_scene_with(
 
     // The checks above should leave nothing for `Scene::new` to reject;
     // should they miss a case, the error still names the key to blame.
-    let mut scene = Scene::new(objects, materials, lights, sky, camera).map_err(|e| {
+    let scene = Scene::new(objects, materials, lights, sky, camera).map_err(|e| {
         let (span, key) = match &e {
             SceneError::InvalidLight(i) => light_places
                 .get(*i)
@@ -202,7 +201,6 @@ pub fn parse_scene_with(
         };
         src.error(span, &key, e.to_string())
     })?;
-    scene.quad_sampling = quad_sampling;
     Ok(SceneFile { scene, settings })
 }
 
@@ -210,7 +208,6 @@ fn parse_render(
     src: &Source<'_>,
     render: &Table<'_, '_>,
     settings: &mut RenderSettings,
-    quad_sampling: &mut QuadSampling,
 ) -> Result<()> {
     render.deny_unknown(
         src,
@@ -280,7 +277,7 @@ fn parse_render(
     )?;
     settings.epsilon_rel = render.opt_f32(src, "epsilon", Check::Positive, settings.epsilon_rel)?;
     if let Some((name, span)) = render.str(src, "quad_sampling")? {
-        *quad_sampling = match name {
+        settings.quad_sampling = match name {
             "area" => QuadSampling::Area,
             "solid-angle" => QuadSampling::SolidAngle,
             _ => {
