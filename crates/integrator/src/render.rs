@@ -223,7 +223,7 @@ pub struct RenderOutput {
 /// `ThreadPool::install` to choose the thread count. The image does not
 /// depend on it: each random number depends only on (pixel, sample index,
 /// dimension, seed), and each pixel merges its samples in a fixed tree (see
-/// [`crate::film`]).
+/// `film.rs`).
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
@@ -258,7 +258,7 @@ pub struct Pass {
 /// `film`: one pass of a progressive render, or one shard's part of a
 /// render (a film made by [`Film::starting_at`]). Every way of cutting
 /// `0..spp` into passes and shards gives the bit-identical film (see the
-/// [`crate::film`] module), and the image does not depend on the thread
+/// `film.rs`), and the image does not depend on the thread
 /// count either.
 ///
 /// `settings.spp` is the spp of the whole render: some samplers lay their
