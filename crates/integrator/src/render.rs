@@ -257,7 +257,7 @@ pub struct Pass {
 /// Adds sample indices `film.samples().end..until` to every pixel of
 /// `film`: one pass of a progressive render, or one shard's part of a
 /// render (a film made by [`Film::starting_at`]). Every way of cutting
-/// `0..spp` into passes and shards gives the bit-identical film (see the
+/// `0..spp` into passes and shards gives the bit-identical film (see
 /// `film.rs`), and the image does not depend on the thread
 /// count either.
 ///
