@@ -87,12 +87,7 @@ pub(crate) fn radiance(
         settings,
         march,
     } = *estimator;
-    let lighting = Lighting {
-        scene,
-        emitters: scene.emitters(settings.quad_sampling),
-        params: march.secondary,
-        marching: march.marching,
-    };
+    let lighting = Lighting::of(scene, settings, &march);
     let mut radiance = Vec3::ZERO;
     let mut beta = Vec3::ONE;
     let mut previous = Previous::camera(ray.origin);

@@ -14,8 +14,8 @@ use lueur_sampling::{Sampler, power_heuristic};
 use lueur_sdf_math::{Ray, TraceParams};
 
 use crate::light_sampler::Emitters;
-use crate::surface::SurfacePoint;
-use crate::{Marching, Scene, TraceCounters};
+use crate::surface::{March, SurfacePoint};
+use crate::{Marching, RenderSettings, Scene, TraceCounters};
 
 /// Sampler dimensions consumed per path vertex, so that each bounce reads
 /// the same dimensions whatever happened before (low-discrepancy point sets
@@ -246,7 +246,18 @@ pub(crate) struct Lighting<'a> {
     pub marching: Marching,
 }
 
-impl Lighting<'_> {
+impl<'a> Lighting<'a> {
+    /// The lighting of `scene` rendered with `settings`, secondary rays marched as
+    /// `march` says.
+    pub fn of(scene: &'a Scene, settings: &RenderSettings, march: &March) -> Lighting<'a> {
+        Lighting {
+            scene,
+            emitters: scene.emitters(settings.quad_sampling),
+            params: march.secondary,
+            marching: march.marching,
+        }
+    }
+
     /// Light from every delta light, by a shadow ray each (a delta light can
     /// be reached no other way).
     pub fn delta_lights(&self, v: &Vertex, shadow: &mut TraceCounters) -> Vec3 {

@@ -137,34 +137,8 @@ pub fn parse_scene_with(
     }
 
     let mut objects = Vec::new();
-    for (i, entry) in array_of_tables(&src, &top, "objects")?
-        .into_iter()
-        .enumerate()
-    {
-        entry.deny_unknown(&src, &["material", "shape"])?;
-        let (name, span) =
-            entry.req_str(&src, "material", "the name of a material in [materials]")?;
-        let Some(&material) = material_index.get(name) else {
-            let known: Vec<_> = material_index.keys().map(|k| format!("`{k}`")).collect();
-            return Err(src.error(
-                span,
-                &entry.key_path("material"),
-                format!(
-                    "unknown material `{name}`; defined: {}",
-                    if known.is_empty() {
-                        "none".into()
-                    } else {
-                        known.join(", ")
-                    }
-                ),
-            ));
-        };
-        let shape = entry
-            .get("shape")
-            .ok_or_else(|| entry.missing(&src, "shape", "a shape table"))?;
-        let sdf = parse_shape(&src, shape, entry.key_path("shape"), 0)?;
-        let _ = i;
-        objects.push(Object { sdf, material });
+    for entry in array_of_tables(&src, &top, "objects")? {
+        objects.push(parse_object(&src, &entry, &material_index)?);
     }
 
     let mut lights = Vec::new();
@@ -198,6 +172,36 @@ pub fn parse_scene_with(
         src.error(span, &key, e.to_string())
     })?;
     Ok(SceneFile { scene, settings })
+}
+
+/// One `[[objects]]` entry: a shape and the name of its material.
+fn parse_object(
+    src: &Source<'_>,
+    entry: &Table<'_, '_>,
+    material_index: &HashMap<&str, usize>,
+) -> Result<Object> {
+    entry.deny_unknown(src, &["material", "shape"])?;
+    let (name, span) = entry.req_str(src, "material", "the name of a material in [materials]")?;
+    let Some(&material) = material_index.get(name) else {
+        let known: Vec<_> = material_index.keys().map(|k| format!("`{k}`")).collect();
+        return Err(src.error(
+            span,
+            &entry.key_path("material"),
+            format!(
+                "unknown material `{name}`; defined: {}",
+                if known.is_empty() {
+                    "none".into()
+                } else {
+                    known.join(", ")
+                }
+            ),
+        ));
+    };
+    let shape = entry
+        .get("shape")
+        .ok_or_else(|| entry.missing(src, "shape", "a shape table"))?;
+    let sdf = parse_shape(src, shape, entry.key_path("shape"), 0)?;
+    Ok(Object { sdf, material })
 }
 
 fn parse_render(
