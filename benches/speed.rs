@@ -19,9 +19,11 @@ fn load(name: &str, marching: Marching) -> (Scene, RenderSettings) {
     let file = format!("{}/scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(&file).expect("shipped scenes are readable");
     let parsed = parse_scene(&text, &file).expect("shipped scenes parse");
-    let mut scene = parsed.scene;
-    scene.marching = marching;
-    (scene, parsed.settings)
+    let settings = RenderSettings {
+        marching,
+        ..parsed.settings
+    };
+    (parsed.scene, settings)
 }
 
 /// Camera rays through a 32x32 grid of pixel centres of a 256x256 image.
@@ -63,7 +65,7 @@ fn scene_evaluation(c: &mut Criterion) {
                 b.iter(|| {
                     points
                         .iter()
-                        .map(|&p| scene.distance(black_box(p)))
+                        .map(|&p| scene.distance(black_box(p), marching))
                         .sum::<f32>()
                 })
             });
@@ -84,7 +86,12 @@ fn camera_ray(c: &mut Criterion) {
                 b.iter(|| {
                     let mut counters = TraceCounters::default();
                     for ray in &rays {
-                        black_box(scene.intersect(black_box(ray), &params, &mut counters));
+                        black_box(scene.intersect(
+                            black_box(ray),
+                            &params,
+                            marching,
+                            &mut counters,
+                        ));
                     }
                     counters.steps
                 })

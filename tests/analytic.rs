@@ -170,7 +170,7 @@ fn direct_light_mismatches(
         normal: Vec3::Y,
         height: 0.0,
     };
-    let mut scene = scene_of(
+    let scene = scene_of(
         vec![plane],
         Material::Lambertian {
             albedo: Vec3::splat(0.6),
@@ -179,7 +179,6 @@ fn direct_light_mismatches(
         None,
         camera,
     );
-    scene.quad_sampling = quad_sampling;
     // With one scattering event, `light` sees everything there is to see.
     for strategy in Strategy::ALL {
         let settings = RenderSettings {
@@ -193,6 +192,7 @@ fn direct_light_mismatches(
             spp: 1 << 18,
             strategy,
             max_depth: 1,
+            quad_sampling,
             ..Default::default()
         };
         let (mean, stderr) = run(&scene, &settings).film.image_mean();

@@ -25,8 +25,7 @@ const SIZE: u32 = 32;
 const REGIONS: u32 = 4;
 
 fn render(name: &str, marching: Marching, seed: u64) -> Film {
-    let mut file = shipped(name);
-    file.scene.marching = marching;
+    let file = shipped(name);
     let settings = RenderSettings {
         sampler: SamplerKind::Independent,
         width: SIZE,
@@ -34,6 +33,7 @@ fn render(name: &str, marching: Marching, seed: u64) -> Film {
         spp: 256,
         strategy: Strategy::Mis,
         seed,
+        marching,
         ..file.settings.clone()
     };
     run(&file.scene, &settings).film

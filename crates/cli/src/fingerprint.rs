@@ -6,7 +6,7 @@
 //! `lueur.settings` attribute); the scene overrides (`--set`) come last,
 //! as a TOML array of strings, since they may hold spaces.
 
-use lueur_integrator::{PixelBounds, RenderSettings};
+use lueur_integrator::{Marching, PixelBounds, RenderSettings};
 
 /// The settings of a render, as named text fields in a fixed order.
 #[derive(Clone, Debug, PartialEq)]
@@ -24,7 +24,6 @@ impl Fingerprint {
     /// sample range `shard` when it is one, with the scene overrides `set`.
     pub fn of(
         s: &RenderSettings,
-        naive: bool,
         crop: Option<PixelBounds>,
         shard: Option<&std::ops::Range<u32>>,
         set: &[String],
@@ -46,7 +45,7 @@ impl Fingerprint {
             ("max_steps", s.max_steps.to_string()),
             ("pixel_epsilon", s.pixel_epsilon.to_string()),
             ("epsilon", s.epsilon_rel.to_string()),
-            ("naive", naive.to_string()),
+            ("naive", (s.marching == Marching::Naive).to_string()),
             ("replicates", s.replicate_count().to_string()),
             ("spp", s.spp.to_string()),
             ("crop", crop),
@@ -179,24 +178,22 @@ mod tests {
             y0: 2,
             y1: 3,
         };
-        let fp = Fingerprint::of(
-            &RenderSettings::default(),
-            true,
-            Some(crop),
-            Some(&(4..8)),
-            &set,
-        );
+        let naive = RenderSettings {
+            marching: Marching::Naive,
+            ..Default::default()
+        };
+        let fp = Fingerprint::of(&naive, Some(crop), Some(&(4..8)), &set);
         let back = Fingerprint::parse(&fp.to_string());
         assert_eq!(back, fp);
         assert_eq!(back.overrides(), set);
         assert_eq!(back.get("crop"), Some("1,5,2,3"));
+        assert_eq!(back.get("naive"), Some("true"));
         let other = Fingerprint::of(
             &RenderSettings {
                 seed: 3,
                 spp: 7,
-                ..Default::default()
+                ..naive.clone()
             },
-            true,
             Some(crop),
             None,
             &set,

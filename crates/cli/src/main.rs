@@ -302,10 +302,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     };
     let overrides: Vec<&str> = args.set.iter().map(String::as_str).collect();
     let parsed = parse_scene_with(&text, &file, &overrides)?;
-    let mut scene = parsed.scene;
-    if args.naive {
-        scene.marching = Marching::Naive;
-    }
+    let scene = parsed.scene;
     let settings = apply_flags(parsed.settings, &args)?;
     let range = render_range(&args, &settings)?;
     let (out, format) = validate::render_outputs(&args)?;
@@ -327,13 +324,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     let whole = PixelBounds::whole(settings.width, settings.height);
     let region = bounds.unwrap_or(whole);
     let pixels = u64::from(region.width()) * u64::from(region.height());
-    let fingerprint = Fingerprint::of(
-        &settings,
-        args.naive,
-        bounds,
-        args.sample_range.as_ref(),
-        &args.set,
-    );
+    let fingerprint = Fingerprint::of(&settings, bounds, args.sample_range.as_ref(), &args.set);
     let film = match (&args.resume, &resumed) {
         (Some(path), Some(resumed)) => {
             resume::load(path, resumed, &text, &fingerprint, settings.sampler, &range)?
@@ -587,6 +578,9 @@ fn run_merge(args: MergeArgs) -> Result<()> {
 }
 
 fn apply_flags(mut s: RenderSettings, a: &RenderArgs) -> Result<RenderSettings> {
+    if a.naive {
+        s.marching = Marching::Naive;
+    }
     if let Some(v) = a.spp {
         s.spp = v;
     }

@@ -7,10 +7,12 @@
 //! variances* with [`RenderStats`]: lueur exists to compare sampling
 //! choices, so every render carries its own error estimate.
 //!
-//! The design decision that shapes the crate: a [`Strategy`] is one `match`
-//! arm in the path loop (`path.rs`), so the five ways of choosing a
-//! direction share everything else (tracing, mirrors, Russian roulette,
-//! directional lights) and differ only where the report says they do.
+//! The design decision that shapes the crate: a [`Strategy`] is one function
+//! from a vertex and its random numbers to a named scatter (`strategy.rs`),
+//! so the five ways of choosing a direction share everything else (tracing,
+//! mirrors, Russian roulette, directional lights) and differ only where the
+//! report says they do; the path loop (`path.rs`) strings the stages
+//! together.
 //!
 //! Contracts: renders are deterministic (same scene, settings and seed give
 //! the same film bit for bit, whatever the thread count); NaN or infinite
@@ -45,24 +47,30 @@
 
 mod camera;
 mod film;
+mod geometry;
+mod light;
+mod light_sampler;
 mod path;
 mod render;
 mod replicates;
 mod scene;
 mod strategy;
+mod surface;
+mod trace;
 
 pub use camera::Camera;
 pub use film::{Film, FilmError, PixelStats, dyadic_blocks, is_dyadic};
+pub use geometry::Marching;
+pub use light::{Light, QuadSampling};
 pub use path::RayCounters;
 pub use render::{
     Pass, PixelBounds, RenderOutput, RenderSettings, RenderStats, render, render_pass,
     render_pass_in,
 };
 pub use replicates::{DEFAULT_REPLICATES, PixelEstimate, default_replicates};
-pub use scene::{
-    Hit, Light, Marching, Object, QuadSampling, STEP_BUCKETS, Scene, TIMED_EVERY, TraceCounters,
-};
+pub use scene::{Object, Scene};
 pub use strategy::Strategy;
+pub use trace::{Hit, STEP_BUCKETS, TIMED_EVERY, TraceCounters};
 
 /// A scene that cannot be rendered as given.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

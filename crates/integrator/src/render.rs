@@ -9,9 +9,11 @@ use lueur_sampling::{Sampler, SamplerKind};
 use rayon::prelude::*;
 
 use crate::film::{Film, PixelStats};
-use crate::path::{CAMERA_DIMS, Estimator, March, RayCounters, SampleId, radiance};
+use crate::path::{Estimator, RayCounters, SampleId, radiance};
 use crate::replicates::{BlockCounter, default_replicates};
-use crate::{RenderError, Scene, Strategy};
+use crate::strategy::CAMERA_DIMS;
+use crate::surface::March;
+use crate::{Marching, QuadSampling, RenderError, Scene, Strategy};
 
 /// Side of the square tiles the image is cut into. Small enough that both
 /// cores stay busy to the end, large enough that scheduling is negligible.
@@ -57,6 +59,11 @@ pub struct RenderSettings {
     /// Secondary rays hit when closer than this fraction of the distance
     /// travelled.
     pub epsilon_rel: f32,
+    /// How rays are marched through the objects (both modes find the same
+    /// surfaces; `Naive` is the reference of the speed-ups).
+    pub marching: Marching,
+    /// How quad lights are sampled toward a shading point.
+    pub quad_sampling: QuadSampling,
 }
 
 impl Default for RenderSettings {
@@ -80,6 +87,8 @@ impl Default for RenderSettings {
             // none at a sixteenth: docs/PEERS.md), for no measurable time.
             pixel_epsilon: 0.0625,
             epsilon_rel: 1e-4,
+            marching: Marching::default(),
+            quad_sampling: QuadSampling::default(),
         }
     }
 }
@@ -214,7 +223,7 @@ pub struct RenderOutput {
 /// `ThreadPool::install` to choose the thread count. The image does not
 /// depend on it: each random number depends only on (pixel, sample index,
 /// dimension, seed), and each pixel merges its samples in a fixed tree (see
-/// [`crate::film`]).
+/// `film.rs`).
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
@@ -248,8 +257,8 @@ pub struct Pass {
 /// Adds sample indices `film.samples().end..until` to every pixel of
 /// `film`: one pass of a progressive render, or one shard's part of a
 /// render (a film made by [`Film::starting_at`]). Every way of cutting
-/// `0..spp` into passes and shards gives the bit-identical film (see the
-/// [`crate::film`] module), and the image does not depend on the thread
+/// `0..spp` into passes and shards gives the bit-identical film (see
+/// `film.rs`), and the image does not depend on the thread
 /// count either.
 ///
 /// `settings.spp` is the spp of the whole render: some samplers lay their

@@ -1,6 +1,323 @@
-//! The ways a path chooses its next direction.
+//! The ways a path chooses its next direction, as pieces: the named sample
+//! layout of a vertex, one function per strategy returning a [`Scatter`],
+//! next-event estimation and delta lights through a [`Lighting`] context,
+//! and the MIS weights in one place ([`EmissionWeight`],
+//! [`next_event_weight`]). Every function here is a pure function of its
+//! inputs (and the counters it is handed), so a tracer of batches of rays
+//! can call them per ray.
 
 use std::fmt;
+
+use glam::{Vec2, Vec3};
+use lueur_materials::{HemisphereSampling, Material};
+use lueur_sampling::{Sampler, power_heuristic};
+use lueur_sdf_math::{Ray, TraceParams};
+
+use crate::light_sampler::Emitters;
+use crate::surface::{March, SurfacePoint};
+use crate::{Marching, RenderSettings, Scene, TraceCounters};
+
+/// Sampler dimensions consumed per path vertex, so that each bounce reads
+/// the same dimensions whatever happened before (low-discrepancy point sets
+/// keep their structure per bounce): the fields of [`VertexSample`] and one
+/// spare.
+pub(crate) const DIMS_PER_VERTEX: u32 = 8;
+/// Dimensions before the first vertex: the position in the pixel.
+pub(crate) const CAMERA_DIMS: u32 = 2;
+
+/// The random numbers of one vertex, in the order they are drawn (the spare
+/// eighth dimension is not drawn).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct VertexSample {
+    /// Which emitter light sampling aims at.
+    pub emitter_choice: f32,
+    /// The point on that emitter.
+    pub emitter: Vec2,
+    /// Which half of the mixture strategy samples.
+    pub mixture: f32,
+    /// The BSDF's direction.
+    pub bsdf: Vec2,
+    /// Whether Russian roulette ends the path.
+    pub roulette: f32,
+}
+
+impl VertexSample {
+    /// The numbers of vertex `depth` of sample `index` of `pixel`.
+    pub fn draw(sampler: &mut Sampler, pixel: [u32; 2], index: u32, depth: u32) -> VertexSample {
+        sampler.start_pixel_sample(pixel, index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
+        let emitter_choice = sampler.next_1d();
+        let emitter = sampler.next_2d();
+        let mixture = sampler.next_1d();
+        let bsdf = sampler.next_2d();
+        let roulette = sampler.next_1d();
+        VertexSample {
+            emitter_choice,
+            emitter,
+            mixture,
+            bsdf,
+            roulette,
+        }
+    }
+}
+
+/// A scattering vertex as the strategies see it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Vertex {
+    /// The shading point, its normal and where rays leave from.
+    pub at: SurfacePoint,
+    /// Unit direction toward where the path came from.
+    pub wo: Vec3,
+    /// What the surface is made of.
+    pub material: Material,
+}
+
+/// How emission found along a sampled direction counts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum EmissionWeight {
+    /// In full: camera rays, delta bounces, and every strategy but `mis`.
+    Full,
+    /// By the power heuristic of `bsdf_pdf` against the pdf next-event
+    /// estimation had for the same direction, which has counted the rest.
+    PowerHeuristic {
+        /// The pdf with which the BSDF chose the direction.
+        bsdf_pdf: f32,
+    },
+}
+
+impl EmissionWeight {
+    /// The weight of emission found along the direction; `light_pdf` is the
+    /// pdf next-event estimation would have had for it, asked only if needed.
+    pub fn weight(self, light_pdf: impl FnOnce() -> f32) -> f32 {
+        match self {
+            EmissionWeight::Full => 1.0,
+            EmissionWeight::PowerHeuristic { bsdf_pdf } => {
+                power_heuristic(1.0, bsdf_pdf, 1.0, light_pdf())
+            }
+        }
+    }
+}
+
+/// The weight of a next-event sample of pdf `light_pdf` against the BSDF
+/// sampling of `mis`, which could have found it with `bsdf_pdf`: the other
+/// half of [`EmissionWeight::PowerHeuristic`].
+pub(crate) fn next_event_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
+    power_heuristic(1.0, light_pdf, 1.0, bsdf_pdf)
+}
+
+/// The BSDF sampling that `mis` combines with next-event estimation.
+const MIS_HEMISPHERE: HemisphereSampling = HemisphereSampling::Cosine;
+
+/// Where a path goes next from a vertex.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Scatter {
+    /// Unit direction of the next ray.
+    pub wi: Vec3,
+    /// What the throughput is multiplied by: `f cos / pdf`.
+    pub weight: Vec3,
+    /// The solid-angle pdf of `wi` (0 for a delta event).
+    pub pdf: f32,
+    /// How emission found along `wi` counts.
+    pub emission: EmissionWeight,
+}
+
+/// A delta bounce on a mirror, followed by every strategy.
+pub(crate) fn mirror(v: &Vertex, u_bsdf: Vec2) -> Option<Scatter> {
+    let s = v
+        .material
+        .sample(v.wo, v.at.n, u_bsdf, HemisphereSampling::Cosine)?;
+    Some(Scatter {
+        wi: s.wi,
+        weight: s.weight(v.at.n),
+        pdf: 0.0,
+        emission: EmissionWeight::Full,
+    })
+}
+
+/// The direction of `strategy` at a diffuse vertex.
+pub(crate) fn scatter(
+    strategy: Strategy,
+    emitters: &Emitters<'_>,
+    v: &Vertex,
+    u: &VertexSample,
+) -> Option<Scatter> {
+    match strategy {
+        Strategy::Uniform => hemisphere(v, HemisphereSampling::Uniform, u.bsdf),
+        Strategy::Cosine => hemisphere(v, HemisphereSampling::Cosine, u.bsdf),
+        Strategy::Light => toward_emitters(emitters, v, u.emitter_choice, u.emitter),
+        Strategy::Mixture => mixture(emitters, v, u),
+        Strategy::Mis => mis_bsdf(v, u.bsdf),
+    }
+}
+
+/// `uniform` and `cosine`: BSDF sampling over the hemisphere; emission found
+/// later counts in full.
+pub(crate) fn hemisphere(v: &Vertex, hemisphere: HemisphereSampling, u: Vec2) -> Option<Scatter> {
+    let s = v.material.sample(v.wo, v.at.n, u, hemisphere)?;
+    Some(Scatter {
+        wi: s.wi,
+        weight: s.weight(v.at.n),
+        pdf: s.pdf,
+        emission: EmissionWeight::Full,
+    })
+}
+
+/// `light`: a direction toward a chosen emitter only, with the pdf summed
+/// over every emitter (biased: directions no emitter subtends are never
+/// taken).
+pub(crate) fn toward_emitters(
+    emitters: &Emitters<'_>,
+    v: &Vertex,
+    u_choice: f32,
+    u: Vec2,
+) -> Option<Scatter> {
+    let (p, n) = (v.at.p, v.at.n);
+    let (es, _) = emitters.sample(p, n, u_choice, u)?;
+    let pdf = emitters.pdf(p, n, es.wi);
+    weighted(v, es.wi, pdf)
+}
+
+/// `mixture`: one-sample MIS, the uniform hemisphere or an emitter with
+/// probability 1/2 each, weighted by [`mixture_pdf`].
+pub(crate) fn mixture(emitters: &Emitters<'_>, v: &Vertex, u: &VertexSample) -> Option<Scatter> {
+    let use_light = emitters.any() && u.mixture >= 0.5;
+    let wi = if use_light {
+        emitters
+            .sample(v.at.p, v.at.n, u.emitter_choice, u.emitter)?
+            .0
+            .wi
+    } else {
+        v.material
+            .sample(v.wo, v.at.n, u.bsdf, HemisphereSampling::Uniform)?
+            .wi
+    };
+    weighted(v, wi, mixture_pdf(emitters, v, wi))
+}
+
+/// The pdf with which [`mixture`] picks `wi`: the average of the uniform
+/// hemisphere's and the emitters', or the hemisphere's alone without
+/// emitters.
+pub(crate) fn mixture_pdf(emitters: &Emitters<'_>, v: &Vertex, wi: Vec3) -> f32 {
+    let hemisphere_pdf = v
+        .material
+        .pdf(v.wo, wi, v.at.n, HemisphereSampling::Uniform);
+    if emitters.any() {
+        0.5 * hemisphere_pdf + 0.5 * emitters.pdf(v.at.p, v.at.n, wi)
+    } else {
+        hemisphere_pdf
+    }
+}
+
+/// `mis`'s BSDF half: cosine sampling, with emission found along it weighted
+/// against next-event estimation ([`Lighting::next_event`] is the other
+/// half).
+pub(crate) fn mis_bsdf(v: &Vertex, u: Vec2) -> Option<Scatter> {
+    let s = v.material.sample(v.wo, v.at.n, u, MIS_HEMISPHERE)?;
+    Some(Scatter {
+        wi: s.wi,
+        weight: s.weight(v.at.n),
+        pdf: s.pdf,
+        emission: EmissionWeight::PowerHeuristic { bsdf_pdf: s.pdf },
+    })
+}
+
+/// A direction `wi` chosen with `pdf` by a strategy that does not sample the
+/// BSDF; `None` where it carries no weight.
+fn weighted(v: &Vertex, wi: Vec3, pdf: f32) -> Option<Scatter> {
+    let n = v.at.n;
+    let f = v.material.eval(v.wo, wi, n);
+    if !(pdf > 0.0) || f == Vec3::ZERO {
+        return None;
+    }
+    Some(Scatter {
+        wi,
+        weight: f * n.dot(wi).abs() / pdf,
+        pdf,
+        emission: EmissionWeight::Full,
+    })
+}
+
+/// What shadow rays need: the scene to trace them in, its emitters, and how
+/// secondary rays are marched.
+#[derive(Clone, Copy)]
+pub(crate) struct Lighting<'a> {
+    pub scene: &'a Scene,
+    pub emitters: Emitters<'a>,
+    pub params: TraceParams,
+    pub marching: Marching,
+}
+
+impl<'a> Lighting<'a> {
+    /// The lighting of `scene` rendered with `settings`, secondary rays marched as
+    /// `march` says.
+    pub fn of(scene: &'a Scene, settings: &RenderSettings, march: &March) -> Lighting<'a> {
+        Lighting {
+            scene,
+            emitters: scene.emitters(settings.quad_sampling),
+            params: march.secondary,
+            marching: march.marching,
+        }
+    }
+
+    /// Light from every delta light, by a shadow ray each (a delta light can
+    /// be reached no other way).
+    pub fn delta_lights(&self, v: &Vertex, shadow: &mut TraceCounters) -> Vec3 {
+        let (n, wo) = (v.at.n, v.wo);
+        let mut sum = Vec3::ZERO;
+        for light in &self.scene.lights {
+            let Some((wi, irradiance)) = light.delta_arrival() else {
+                continue;
+            };
+            let cos = n.dot(wi);
+            if cos <= 0.0 {
+                continue;
+            }
+            let f = v.material.eval(wo, wi, n);
+            if f == Vec3::ZERO {
+                continue;
+            }
+            let ray = Ray::new(v.at.origin, wi);
+            if self.scene.unoccluded(
+                &ray,
+                f32::INFINITY,
+                None,
+                &self.params,
+                self.marching,
+                shadow,
+            ) {
+                sum += f * irradiance * cos;
+            }
+        }
+        sum
+    }
+
+    /// Next-event estimation toward one chosen emitter, weighted against
+    /// `mis`'s BSDF sampling by [`next_event_weight`].
+    pub fn next_event(&self, v: &Vertex, u: &VertexSample, shadow: &mut TraceCounters) -> Vec3 {
+        let (n, wo) = (v.at.n, v.wo);
+        let Some((es, light)) = self.emitters.sample(v.at.p, n, u.emitter_choice, u.emitter) else {
+            return Vec3::ZERO;
+        };
+        let f = v.material.eval(wo, es.wi, n);
+        let cos = n.dot(es.wi).abs();
+        if f == Vec3::ZERO || cos == 0.0 || es.radiance == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        let (shadow_ray, distance) = v.at.shadow_ray(es.wi, es.distance);
+        if !self.scene.unoccluded(
+            &shadow_ray,
+            distance,
+            light,
+            &self.params,
+            self.marching,
+            shadow,
+        ) {
+            return Vec3::ZERO;
+        }
+        let bsdf_pdf = v.material.pdf(wo, es.wi, n, MIS_HEMISPHERE);
+        let w = next_event_weight(es.pdf, bsdf_pdf);
+        f * es.radiance * cos * w / es.pdf
+    }
+}
 
 /// How directions are chosen at a diffuse vertex: the knob lueur exists to
 /// measure. All strategies handle mirrors as delta events and directional
@@ -62,5 +379,205 @@ impl Strategy {
 impl fmt::Display for Strategy {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! Each strategy's directions against the pdf it reports: Pearson's
+    //! chi-square in equal-solid-angle bins over the hemisphere of the
+    //! normal (`lueur_sampling::DirectionBins`), after checking that the pdf
+    //! each sample reports is the strategy's pdf at its direction.
+    use super::*;
+    use crate::{Camera, Light, QuadSampling};
+    use lueur_sampling::DirectionBins;
+
+    const N_SAMPLES: usize = 200_000;
+    const N_Z: usize = 16;
+    const N_PHI: usize = 32;
+    /// Midpoint sub-grid per bin: fine enough that the bins straddling a
+    /// light's edge are integrated to well under one standard deviation.
+    const SUB: usize = 16;
+    /// A correct strategy is rejected with probability 1e-4 (seeds are
+    /// fixed, so a pass is reproducible); a pdf off by a few percent over a
+    /// light's cone is rejected with p far below it.
+    const SIGNIFICANCE: f64 = 1e-4;
+
+    /// Uniform numbers in [0, 1) from a fixed seed (SplitMix64).
+    fn uniforms(seed: u64) -> impl FnMut() -> f32 {
+        let mut state = seed;
+        move || {
+            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    fn vertex_sample(next: &mut impl FnMut() -> f32) -> VertexSample {
+        VertexSample {
+            emitter_choice: next(),
+            emitter: Vec2::new(next(), next()),
+            mixture: next(),
+            bsdf: Vec2::new(next(), next()),
+            roulette: next(),
+        }
+    }
+
+    /// A diffuse vertex at the origin facing +y, seen from above at a slant.
+    fn vertex() -> Vertex {
+        Vertex {
+            at: SurfacePoint {
+                p: Vec3::ZERO,
+                n: Vec3::Y,
+                origin: Vec3::Y * 1e-5,
+                inside: false,
+            },
+            wo: Vec3::new(0.3, 1.0, 0.2).normalize(),
+            material: Material::Lambertian {
+                albedo: Vec3::splat(0.7),
+            },
+        }
+    }
+
+    /// A sphere light and a quad light above the vertex, apart, facing it;
+    /// and a sky if asked.
+    fn scene(sky: bool) -> Scene {
+        let lights = vec![
+            Light::Sphere {
+                center: Vec3::new(-2.0, 3.0, 0.5),
+                radius: 1.0,
+                radiance: Vec3::ONE,
+            },
+            Light::Quad {
+                corner: Vec3::new(1.0, 2.5, -1.0),
+                edge_u: Vec3::new(2.0, 0.0, 0.0),
+                edge_v: Vec3::new(0.0, 0.0, 2.0),
+                radiance: Vec3::ONE,
+            },
+        ];
+        let camera = Camera::new(Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0).unwrap();
+        let sky = sky.then_some(Vec3::splat(0.5));
+        Scene::new(vec![], vec![], lights, sky, camera).unwrap()
+    }
+
+    /// Draws `sample` `N_SAMPLES` times; every reported pdf must be `pdf` at
+    /// the direction drawn, and the directions must fit `pdf`.
+    fn check(
+        name: &str,
+        seed: u64,
+        sample: impl Fn(&VertexSample) -> Option<(Vec3, f32)>,
+        pdf: impl Fn(Vec3) -> f32,
+    ) {
+        let sample = |u: &VertexSample| sample(u).map(|(wi, reported)| (wi, reported, pdf(wi)));
+        check_reporting(name, seed, sample, &pdf);
+    }
+
+    /// [`check`] where `sample` also says which pdf it should have reported
+    /// (next-event estimation reports the pdf of the emitter it chose, not
+    /// the sum over the emitters that `pdf` is).
+    fn check_reporting(
+        name: &str,
+        seed: u64,
+        sample: impl Fn(&VertexSample) -> Option<(Vec3, f32, f32)>,
+        pdf: impl Fn(Vec3) -> f32,
+    ) {
+        let mut next = uniforms(seed);
+        let mut directions = Vec::with_capacity(N_SAMPLES);
+        for _ in 0..N_SAMPLES {
+            let Some((wi, reported, expected)) = sample(&vertex_sample(&mut next)) else {
+                continue;
+            };
+            assert!(
+                (reported - expected).abs() <= 1e-4 * expected,
+                "{name}: reports pdf {reported} for {wi}, where its pdf is {expected}"
+            );
+            directions.push(wi);
+        }
+        assert!(
+            directions.len() >= N_SAMPLES * 999 / 1000,
+            "{name}: only {} of {N_SAMPLES} samples drawn",
+            directions.len()
+        );
+        let bins = DirectionBins::new(Vec3::Y, 0.0, N_Z, N_PHI);
+        let test = bins.test(directions, &pdf, SUB);
+        assert!(test.accepts(SIGNIFICANCE), "{name}: {test:?}");
+    }
+
+    fn reported(s: Scatter) -> (Vec3, f32) {
+        (s.wi, s.pdf)
+    }
+
+    #[test]
+    fn uniform_and_cosine_follow_the_pdf_they_report() {
+        let (v, scene) = (vertex(), scene(true));
+        let emitters = scene.emitters(QuadSampling::default());
+        for (seed, strategy, hemisphere) in [
+            (1, Strategy::Uniform, HemisphereSampling::Uniform),
+            (2, Strategy::Cosine, HemisphereSampling::Cosine),
+        ] {
+            let sample = |u: &VertexSample| scatter(strategy, &emitters, &v, u).map(reported);
+            let pdf = |wi| v.material.pdf(v.wo, wi, v.at.n, hemisphere);
+            check(strategy.name(), seed, sample, pdf);
+        }
+    }
+
+    #[test]
+    fn light_follows_the_pdf_it_reports() {
+        let v = vertex();
+        for (seed, quads) in [(3, QuadSampling::Area), (4, QuadSampling::SolidAngle)] {
+            let scene = scene(true);
+            let emitters = scene.emitters(quads);
+            let sample =
+                |u: &VertexSample| scatter(Strategy::Light, &emitters, &v, u).map(reported);
+            let pdf = |wi| emitters.pdf(v.at.p, v.at.n, wi);
+            check(&format!("light, {quads:?}"), seed, sample, pdf);
+        }
+    }
+
+    #[test]
+    fn mixture_follows_the_pdf_it_reports() {
+        let v = vertex();
+        for (seed, sky) in [(5, true), (6, false)] {
+            let scene = scene(sky);
+            let emitters = scene.emitters(QuadSampling::SolidAngle);
+            let sample =
+                |u: &VertexSample| scatter(Strategy::Mixture, &emitters, &v, u).map(reported);
+            let pdf = |wi| mixture_pdf(&emitters, &v, wi);
+            check(&format!("mixture, sky {sky}"), seed, sample, pdf);
+        }
+    }
+
+    /// Both halves of `mis`: its BSDF directions (cosine), whose emission is
+    /// weighted against the pdf they report, and the directions next-event
+    /// estimation aims at, each reporting the pdf of the emitter chosen
+    /// (which the weight of emission found by the BSDF half is taken
+    /// against), together distributed as the sum over emitters.
+    #[test]
+    fn mis_follows_the_pdfs_it_reports() {
+        let (v, scene) = (vertex(), scene(true));
+        let emitters = scene.emitters(QuadSampling::SolidAngle);
+        let bsdf = |u: &VertexSample| {
+            let s = scatter(Strategy::Mis, &emitters, &v, u)?;
+            assert_eq!(
+                s.emission,
+                EmissionWeight::PowerHeuristic { bsdf_pdf: s.pdf }
+            );
+            Some(reported(s))
+        };
+        let cosine = |wi| v.material.pdf(v.wo, wi, v.at.n, MIS_HEMISPHERE);
+        check("mis, BSDF", 7, bsdf, cosine);
+        let (p, n) = (v.at.p, v.at.n);
+        let next_event = |u: &VertexSample| {
+            let (es, light) = emitters.sample(p, n, u.emitter_choice, u.emitter)?;
+            let chosen = match light {
+                Some(light) => emitters.light_pdf(light, p, n, es.wi),
+                None => emitters.sky_pdf(n, es.wi),
+            };
+            Some((es.wi, es.pdf, chosen))
+        };
+        let pdf = |wi| emitters.pdf(p, n, wi);
+        check_reporting("mis, next event", 8, next_event, pdf);
     }
 }

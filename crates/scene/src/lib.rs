@@ -40,21 +40,21 @@
 mod error;
 mod overrides;
 mod parse;
+mod shape;
 
 use std::collections::HashMap;
 
-use glam::{Quat, Vec3};
+use glam::Vec3;
 use lueur_integrator::{
     Camera, Light, Object, QuadSampling, RenderSettings, Scene, SceneError, Strategy,
 };
 use lueur_materials::Material;
 use lueur_sampling::SamplerKind;
-use lueur_sdf_math::Sdf;
-use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
 pub use error::SceneFileError;
 use parse::{Check, Result, Source, Table, as_table, did_you_mean};
+use shape::parse_shape;
 
 /// A parsed scene file: what to render and how.
 #[derive(Clone, Debug)]
@@ -64,10 +64,6 @@ pub struct SceneFile {
     /// Image size and render settings from `[image]` and `[render]`.
     pub settings: RenderSettings,
 }
-
-/// Nesting depth of CSG shapes beyond which a file is rejected: evaluation
-/// recurses through the tree, and no scene needs more.
-const MAX_SHAPE_DEPTH: usize = 64;
 
 /// Parses a scene from `text`; `file` is the name used in error messages.
 pub fn parse_scene(text: &str, file: &str) -> std::result::Result<SceneFile, SceneFileError> {
@@ -110,7 +106,6 @@ pub fn parse_scene_with(
     )?;
 
     let mut settings = RenderSettings::default();
-    let mut quad_sampling = QuadSampling::default();
     if let Some(image) = top.table(&src, "image")? {
         image.deny_unknown(&src, &["width", "height"])?;
         if let Some(w) = image.u32_in(&src, "width", 1, 65_536)? {
@@ -121,7 +116,7 @@ pub fn parse_scene_with(
         }
     }
     if let Some(render) = top.table(&src, "render")? {
-        parse_render(&src, &render, &mut settings, &mut quad_sampling)?;
+        parse_render(&src, &render, &mut settings)?;
     }
 
     let camera_table = top
@@ -142,34 +137,8 @@ pub fn parse_scene_with(
     }
 
     let mut objects = Vec::new();
-    for (i, entry) in array_of_tables(&src, &top, "objects")?
-        .into_iter()
-        .enumerate()
-    {
-        entry.deny_unknown(&src, &["material", "shape"])?;
-        let (name, span) =
-            entry.req_str(&src, "material", "the name of a material in [materials]")?;
-        let Some(&material) = material_index.get(name) else {
-            let known: Vec<_> = material_index.keys().map(|k| format!("`{k}`")).collect();
-            return Err(src.error(
-                span,
-                &entry.key_path("material"),
-                format!(
-                    "unknown material `{name}`; defined: {}",
-                    if known.is_empty() {
-                        "none".into()
-                    } else {
-                        known.join(", ")
-                    }
-                ),
-            ));
-        };
-        let shape = entry
-            .get("shape")
-            .ok_or_else(|| entry.missing(&src, "shape", "a shape table"))?;
-        let sdf = parse_shape(&src, shape, entry.key_path("shape"), 0)?;
-        let _ = i;
-        objects.push(Object { sdf, material });
+    for entry in array_of_tables(&src, &top, "objects")? {
+        objects.push(parse_object(&src, &entry, &material_index)?);
     }
 
     let mut lights = Vec::new();
@@ -187,7 +156,7 @@ pub fn parse_scene_with(
 
     // The checks above should leave nothing for `Scene::new` to reject;
     // should they miss a case, the error still names the key to blame.
-    let mut scene = Scene::new(objects, materials, lights, sky, camera).map_err(|e| {
+    let scene = Scene::new(objects, materials, lights, sky, camera).map_err(|e| {
         let (span, key) = match &e {
             SceneError::InvalidLight(i) => light_places
                 .get(*i)
@@ -202,15 +171,43 @@ pub fn parse_scene_with(
         };
         src.error(span, &key, e.to_string())
     })?;
-    scene.quad_sampling = quad_sampling;
     Ok(SceneFile { scene, settings })
+}
+
+/// One `[[objects]]` entry: a shape and the name of its material.
+fn parse_object(
+    src: &Source<'_>,
+    entry: &Table<'_, '_>,
+    material_index: &HashMap<&str, usize>,
+) -> Result<Object> {
+    entry.deny_unknown(src, &["material", "shape"])?;
+    let (name, span) = entry.req_str(src, "material", "the name of a material in [materials]")?;
+    let Some(&material) = material_index.get(name) else {
+        let known: Vec<_> = material_index.keys().map(|k| format!("`{k}`")).collect();
+        return Err(src.error(
+            span,
+            &entry.key_path("material"),
+            format!(
+                "unknown material `{name}`; defined: {}",
+                if known.is_empty() {
+                    "none".into()
+                } else {
+                    known.join(", ")
+                }
+            ),
+        ));
+    };
+    let shape = entry
+        .get("shape")
+        .ok_or_else(|| entry.missing(src, "shape", "a shape table"))?;
+    let sdf = parse_shape(src, shape, entry.key_path("shape"), 0)?;
+    Ok(Object { sdf, material })
 }
 
 fn parse_render(
     src: &Source<'_>,
     render: &Table<'_, '_>,
     settings: &mut RenderSettings,
-    quad_sampling: &mut QuadSampling,
 ) -> Result<()> {
     render.deny_unknown(
         src,
@@ -280,7 +277,7 @@ fn parse_render(
     )?;
     settings.epsilon_rel = render.opt_f32(src, "epsilon", Check::Positive, settings.epsilon_rel)?;
     if let Some((name, span)) = render.str(src, "quad_sampling")? {
-        *quad_sampling = match name {
+        settings.quad_sampling = match name {
             "area" => QuadSampling::Area,
             "solid-angle" => QuadSampling::SolidAngle,
             _ => {
@@ -427,243 +424,6 @@ fn parse_light(src: &Source<'_>, t: &Table<'_, '_>) -> Result<Light> {
             ),
         )),
     }
-}
-
-const TRANSFORM_KEYS: [&str; 3] = ["translate", "rotate", "scale"];
-
-const SHAPE_TYPES: [&str; 14] = [
-    "sphere",
-    "box",
-    "round_box",
-    "plane",
-    "torus",
-    "capped_cylinder",
-    "capsule",
-    "death_star",
-    "union",
-    "intersection",
-    "difference",
-    "smooth_union",
-    "smooth_intersection",
-    "smooth_difference",
-];
-
-fn parse_shape(
-    src: &Source<'_>,
-    value: &Spanned<DeValue<'_>>,
-    path: String,
-    depth: usize,
-) -> Result<Sdf> {
-    let t = as_table(src, value, path)?;
-    if depth > MAX_SHAPE_DEPTH {
-        return Err(src.error(
-            t.span.clone(),
-            &t.path,
-            format!("shapes nest deeper than {MAX_SHAPE_DEPTH} levels"),
-        ));
-    }
-    let (kind, span) = t.req_str(src, "type", "the shape's type")?;
-    let allow = |keys: &[&str]| {
-        let mut all: Vec<&str> = vec!["type"];
-        all.extend_from_slice(keys);
-        all.extend_from_slice(&TRANSFORM_KEYS);
-        t.deny_unknown(src, &all)
-    };
-    let center = |t: &Table<'_, '_>| t.opt_vec3(src, "center", Check::Any, Vec3::ZERO);
-    let (sdf, center) = match kind {
-        "sphere" => {
-            allow(&["center", "radius"])?;
-            (
-                Sdf::Sphere {
-                    radius: t.req_f32(src, "radius", Check::Positive)?,
-                },
-                center(&t)?,
-            )
-        }
-        "box" => {
-            allow(&["center", "half_extents"])?;
-            (
-                Sdf::Box {
-                    half_extents: t.req_vec3(src, "half_extents", Check::Positive)?,
-                },
-                center(&t)?,
-            )
-        }
-        "round_box" => {
-            allow(&["center", "half_extents", "radius"])?;
-            let half_extents = t.req_vec3(src, "half_extents", Check::Positive)?;
-            let radius = t.req_f32(src, "radius", Check::NonNegative)?;
-            if radius > half_extents.min_element() {
-                let span = t.get("radius").map_or(t.span.clone(), |v| v.span());
-                return Err(src.error(
-                    span,
-                    &t.key_path("radius"),
-                    "must not exceed the smallest half extent",
-                ));
-            }
-            (
-                Sdf::RoundBox {
-                    half_extents,
-                    radius,
-                },
-                center(&t)?,
-            )
-        }
-        "plane" => {
-            allow(&["normal", "height"])?;
-            let normal = t.req_vec3(src, "normal", Check::NonZeroVector)?.normalize();
-            let height = t.opt_f32(src, "height", Check::Any, 0.0)?;
-            (Sdf::Plane { normal, height }, Vec3::ZERO)
-        }
-        "torus" => {
-            allow(&["center", "major_radius", "minor_radius"])?;
-            let major_radius = t.req_f32(src, "major_radius", Check::Positive)?;
-            let minor_radius = t.req_f32(src, "minor_radius", Check::Positive)?;
-            (
-                Sdf::Torus {
-                    major_radius,
-                    minor_radius,
-                },
-                center(&t)?,
-            )
-        }
-        "capped_cylinder" => {
-            allow(&["center", "radius", "half_height"])?;
-            let radius = t.req_f32(src, "radius", Check::Positive)?;
-            let half_height = t.req_f32(src, "half_height", Check::Positive)?;
-            (
-                Sdf::CappedCylinder {
-                    radius,
-                    half_height,
-                },
-                center(&t)?,
-            )
-        }
-        "capsule" => {
-            allow(&["a", "b", "radius"])?;
-            let a = t.req_vec3(src, "a", Check::Any)?;
-            let b = t.req_vec3(src, "b", Check::Any)?;
-            (
-                Sdf::Capsule {
-                    a,
-                    b,
-                    radius: t.req_f32(src, "radius", Check::Positive)?,
-                },
-                Vec3::ZERO,
-            )
-        }
-        "death_star" => {
-            allow(&["center", "ra", "rb", "d"])?;
-            let ra = t.req_f32(src, "ra", Check::Positive)?;
-            let rb = t.req_f32(src, "rb", Check::Positive)?;
-            let d = t.req_f32(src, "d", Check::Positive)?;
-            (Sdf::DeathStar { ra, rb, d }, center(&t)?)
-        }
-        "union"
-        | "intersection"
-        | "difference"
-        | "smooth_union"
-        | "smooth_intersection"
-        | "smooth_difference" => {
-            let smooth = kind.starts_with("smooth_");
-            if smooth {
-                allow(&["shapes", "k"])?
-            } else {
-                allow(&["shapes"])?
-            }
-            let list = t
-                .get("shapes")
-                .ok_or_else(|| t.missing(src, "shapes", "an array of shapes"))?;
-            let DeValue::Array(items) = list.get_ref() else {
-                return Err(src.error(
-                    list.span(),
-                    &t.key_path("shapes"),
-                    "expected an array of shape tables",
-                ));
-            };
-            let min = if kind.ends_with("difference") { 2 } else { 1 };
-            if items.len() < min {
-                return Err(src.error(
-                    list.span(),
-                    &t.key_path("shapes"),
-                    format!("needs at least {min} shape(s)"),
-                ));
-            }
-            let children = items
-                .iter()
-                .enumerate()
-                .map(|(i, item)| {
-                    parse_shape(
-                        src,
-                        item,
-                        format!("{}[{i}]", t.key_path("shapes")),
-                        depth + 1,
-                    )
-                })
-                .collect::<Result<Vec<_>>>()?;
-            let sdf = if smooth {
-                let k = t.req_f32(src, "k", Check::Positive)?;
-                match kind {
-                    "smooth_union" => Sdf::SmoothUnion { k, children },
-                    "smooth_intersection" => Sdf::SmoothIntersection { k, children },
-                    _ => Sdf::SmoothDifference { k, children },
-                }
-            } else {
-                match kind {
-                    "union" => Sdf::Union(children),
-                    "intersection" => Sdf::Intersection(children),
-                    _ => Sdf::Difference(children),
-                }
-            };
-            (sdf, Vec3::ZERO)
-        }
-        other => {
-            return Err(src.error(
-                span,
-                &t.key_path("type"),
-                format!(
-                    "unknown shape type `{other}`{}; expected one of {}",
-                    did_you_mean(other, SHAPE_TYPES),
-                    SHAPE_TYPES.join(", ")
-                ),
-            ));
-        }
-    };
-    // Transforms apply in the order: centre, scale, rotate, translate.
-    let mut sdf = sdf;
-    if center != Vec3::ZERO {
-        sdf = Sdf::Translate {
-            offset: center,
-            child: Box::new(sdf),
-        };
-    }
-    if let Some(factor) = t
-        .f32(src, "scale")?
-        .map(|_| t.req_f32(src, "scale", Check::Positive))
-        .transpose()?
-    {
-        sdf = Sdf::Scale {
-            factor,
-            child: Box::new(sdf),
-        };
-    }
-    if let Some((degrees, _)) = t.vec3(src, "rotate")? {
-        let r = degrees * std::f32::consts::PI / 180.0;
-        // About the fixed x, then y, then z axes.
-        let rotation =
-            Quat::from_rotation_z(r.z) * Quat::from_rotation_y(r.y) * Quat::from_rotation_x(r.x);
-        sdf = Sdf::Rotate {
-            rotation,
-            child: Box::new(sdf),
-        };
-    }
-    if let Some((offset, _)) = t.vec3(src, "translate")? {
-        sdf = Sdf::Translate {
-            offset,
-            child: Box::new(sdf),
-        };
-    }
-    Ok(sdf)
 }
 
 /// The tables of an array of tables (`[[objects]]`), or of an inline array.

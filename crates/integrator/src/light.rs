@@ -1,0 +1,360 @@
+//! Light sources, one unit: every kind answers here whether it is valid, where a ray meets
+//! it, what it emits toward a ray, how a direction toward it is sampled and with what pdf,
+//! and the box it occupies. [`Light`] is matched in this module and nowhere else, so a new
+//! kind of light is written here (and parsed in `lueur-scene`).
+
+use glam::{Vec2, Vec3};
+use lueur_sampling::{
+    DirectionSample, quad_area_pdf, quad_solid_angle_pdf, sample_quad_area,
+    sample_quad_solid_angle, sample_sphere_light, sphere_light_pdf,
+};
+use lueur_sdf_math::Ray;
+
+/// A light source. Sphere and quad lights are also visible geometry (they
+/// are intersected analytically, which is exact and cheaper than marching a
+/// zero-thickness quad); directional lights are not.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// A sphere emitting `radiance` outward from its surface.
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius (> 0).
+        radius: f32,
+        /// Emitted radiance.
+        radiance: Vec3,
+    },
+    /// A parallelogram `corner + s edge_u + t edge_v`, emitting on the side
+    /// of `edge_u x edge_v`.
+    Quad {
+        /// One corner.
+        corner: Vec3,
+        /// First edge.
+        edge_u: Vec3,
+        /// Second edge.
+        edge_v: Vec3,
+        /// Emitted radiance.
+        radiance: Vec3,
+    },
+    /// A light at infinity: parallel rays travelling along `direction`.
+    Directional {
+        /// Unit direction in which the light travels.
+        direction: Vec3,
+        /// Irradiance received by a surface facing the light.
+        irradiance: Vec3,
+    },
+}
+
+/// How quad lights are sampled toward a shading point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum QuadSampling {
+    /// Uniform on the area, converted to solid angle (pdf d^2 / (cos a * A)),
+    /// as in the student report.
+    Area,
+    /// Uniform in the solid angle the rectangle subtends (Urena et al.
+    /// 2013); falls back to area sampling for non-rectangular parallelograms.
+    #[default]
+    SolidAngle,
+}
+
+/// A direction toward a light (or the sky) with the radiance it brings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct EmitterSample {
+    pub wi: Vec3,
+    pub distance: f32,
+    pub radiance: Vec3,
+    /// Solid-angle pdf of `wi` (including, once chosen by the light
+    /// sampler, the probability of choosing this emitter).
+    pub pdf: f32,
+}
+
+impl Light {
+    /// Whether the light is a delta distribution in direction, reachable only
+    /// by next-event estimation.
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Light::Directional { .. })
+    }
+
+    /// Whether the light can be rendered: a positive size, finite position
+    /// and non-negative radiance.
+    pub(crate) fn is_valid(&self) -> bool {
+        match *self {
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => center.is_finite() && radius > 0.0 && radius.is_finite() && valid_rgb(radiance),
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => corner.is_finite() && edge_u.cross(edge_v).length() > 0.0 && valid_rgb(radiance),
+            Light::Directional {
+                direction,
+                irradiance,
+            } => {
+                direction.is_finite()
+                    && (direction.length() - 1.0).abs() < 1e-3
+                    && valid_rgb(irradiance)
+            }
+        }
+    }
+
+    /// The corners of a box around the light, `None` for a light at
+    /// infinity.
+    pub(crate) fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        match *self {
+            Light::Sphere { center, radius, .. } => {
+                Some((center - Vec3::splat(radius), center + Vec3::splat(radius)))
+            }
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                ..
+            } => {
+                let far = corner + edge_u + edge_v;
+                Some((corner.min(far), corner.max(far)))
+            }
+            Light::Directional { .. } => None,
+        }
+    }
+
+    /// Where `ray` first meets the light's surface (lights at infinity are
+    /// never met).
+    pub(crate) fn intersect(&self, ray: &Ray) -> Option<f32> {
+        match *self {
+            Light::Sphere { center, radius, .. } => ray_sphere(ray, center, radius),
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                ..
+            } => ray_quad(ray, corner, edge_u, edge_v),
+            Light::Directional { .. } => None,
+        }
+    }
+
+    /// Radiance emitted toward `-ray.dir` from the point at `t` along `ray`.
+    pub(crate) fn emitted(&self, ray: &Ray, t: f32) -> Vec3 {
+        match *self {
+            Light::Sphere {
+                center, radiance, ..
+            } => {
+                // Emits outward only: a ray from inside sees the back face.
+                if (ray.at(t) - center).dot(ray.dir) < 0.0 {
+                    radiance
+                } else {
+                    Vec3::ZERO
+                }
+            }
+            Light::Quad {
+                edge_u,
+                edge_v,
+                radiance,
+                ..
+            } => {
+                if edge_u.cross(edge_v).dot(ray.dir) < 0.0 {
+                    radiance
+                } else {
+                    Vec3::ZERO
+                }
+            }
+            Light::Directional { .. } => Vec3::ZERO,
+        }
+    }
+
+    /// For a delta light, the one direction its light arrives from and the
+    /// irradiance it brings there.
+    pub(crate) fn delta_arrival(&self) -> Option<(Vec3, Vec3)> {
+        match *self {
+            Light::Directional {
+                direction,
+                irradiance,
+            } => Some((-direction, irradiance)),
+            Light::Sphere { .. } | Light::Quad { .. } => None,
+        }
+    }
+
+    /// A direction from `p` toward the light's emitting surface, with its
+    /// solid-angle pdf; `None` where the sample has no weight (a back face,
+    /// a delta light).
+    pub(crate) fn sample(
+        &self,
+        p: Vec3,
+        u: Vec2,
+        quad_sampling: QuadSampling,
+    ) -> Option<EmitterSample> {
+        let (s, radiance): (DirectionSample, Vec3) = match *self {
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                let s = sample_sphere_light(p, center, radius, u)?;
+                // Only the outward face emits.
+                if s.normal.dot(s.wi) >= 0.0 {
+                    return None;
+                }
+                (s, radiance)
+            }
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => {
+                let s = match quad_sampling {
+                    QuadSampling::SolidAngle if is_rectangle(edge_u, edge_v) => {
+                        // Falls back to area sampling where the solid angle is
+                        // too small for the spherical-rectangle warp's f32 math.
+                        sample_quad_solid_angle(p, corner, edge_u, edge_v, u)?
+                    }
+                    _ => sample_quad_area(p, corner, edge_u, edge_v, u)?,
+                };
+                (s, radiance)
+            }
+            Light::Directional { .. } => return None,
+        };
+        if !(s.pdf > 0.0) || !s.pdf.is_finite() {
+            return None;
+        }
+        Some(EmitterSample {
+            wi: s.wi,
+            distance: s.distance,
+            radiance,
+            pdf: s.pdf,
+        })
+    }
+
+    /// Solid-angle pdf with which [`Light::sample`] picks `wi` from `p`.
+    pub(crate) fn pdf(&self, p: Vec3, wi: Vec3, quad_sampling: QuadSampling) -> f32 {
+        match *self {
+            Light::Sphere { center, radius, .. } => {
+                // Directions that reach the sphere from inside hit its
+                // back face: the sampler rejects those, so they have
+                // zero density.
+                if (p - center).length_squared() <= radius * radius {
+                    let Some(t) = ray_sphere(&Ray::new(p, wi), center, radius) else {
+                        return 0.0;
+                    };
+                    if (p + wi * t - center).dot(wi) >= 0.0 {
+                        return 0.0;
+                    }
+                }
+                sphere_light_pdf(p, center, radius, wi)
+            }
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                ..
+            } => match quad_sampling {
+                QuadSampling::SolidAngle if is_rectangle(edge_u, edge_v) => {
+                    quad_solid_angle_pdf(p, corner, edge_u, edge_v, wi)
+                }
+                _ => quad_area_pdf(p, corner, edge_u, edge_v, wi),
+            },
+            Light::Directional { .. } => 0.0,
+        }
+    }
+}
+
+/// Whether a colour is a valid radiance: finite and non-negative.
+pub(crate) fn valid_rgb(c: Vec3) -> bool {
+    c.is_finite() && c.min_element() >= 0.0
+}
+
+fn is_rectangle(edge_u: Vec3, edge_v: Vec3) -> bool {
+    edge_u.dot(edge_v).abs() <= 1e-4 * edge_u.length() * edge_v.length()
+}
+
+/// Nearest positive intersection of a ray with a sphere (from outside or
+/// inside). Uses the numerically stable form of pbrt-v4 (section 6.8.1):
+/// the discriminant from `|o - c - (b) d|` avoids cancellation far away.
+pub(crate) fn ray_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<f32> {
+    let oc = ray.origin - center;
+    let b = oc.dot(ray.dir);
+    let perp = oc - b * ray.dir;
+    let disc = radius * radius - perp.length_squared();
+    if disc < 0.0 {
+        return None;
+    }
+    let root = disc.sqrt();
+    let q = if b > 0.0 { -b - root } else { -b + root };
+    let (mut t0, mut t1) = (
+        q,
+        if q != 0.0 {
+            (oc.length_squared() - radius * radius) / q
+        } else {
+            q
+        },
+    );
+    if t0 > t1 {
+        std::mem::swap(&mut t0, &mut t1);
+    }
+    if t0 > 0.0 {
+        Some(t0)
+    } else if t1 > 0.0 {
+        Some(t1)
+    } else {
+        None
+    }
+}
+
+/// Intersection of a ray with the parallelogram `corner + s eu + t ev`.
+pub(crate) fn ray_quad(ray: &Ray, corner: Vec3, edge_u: Vec3, edge_v: Vec3) -> Option<f32> {
+    let n = edge_u.cross(edge_v);
+    let denom = n.dot(ray.dir);
+    if denom == 0.0 {
+        return None;
+    }
+    let t = n.dot(corner - ray.origin) / denom;
+    if !(t > 0.0) || !t.is_finite() {
+        return None;
+    }
+    let q = ray.at(t) - corner;
+    // Coordinates in the (edge_u, edge_v) basis by Cramer's rule with the
+    // plane normal (works for any parallelogram).
+    let nn = n.length_squared();
+    let s = n.dot(q.cross(edge_v)) / nn;
+    let r = n.dot(edge_u.cross(q)) / nn;
+    if (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r) {
+        Some(t)
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ray_sphere_from_outside_and_inside() {
+        let r = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
+        assert!((ray_sphere(&r, Vec3::ZERO, 1.0).unwrap() - 4.0).abs() < 1e-5);
+        let inside = Ray::new(Vec3::ZERO, Vec3::Z);
+        assert!((ray_sphere(&inside, Vec3::ZERO, 1.0).unwrap() - 1.0).abs() < 1e-5);
+        let away = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::Z);
+        assert!(ray_sphere(&away, Vec3::ZERO, 1.0).is_none());
+        let far = Ray::new(Vec3::new(0.0, 0.0, -1e4), Vec3::Z);
+        assert!((ray_sphere(&far, Vec3::ZERO, 1.0).unwrap() - (1e4 - 1.0)).abs() < 1e-2);
+    }
+
+    #[test]
+    fn ray_quad_hits_inside_only() {
+        let (c, u, v) = (
+            Vec3::new(-1.0, 2.0, -1.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 2.0),
+        );
+        let up = Ray::new(Vec3::ZERO, Vec3::Y);
+        assert!((ray_quad(&up, c, u, v).unwrap() - 2.0).abs() < 1e-6);
+        let off = Ray::new(Vec3::new(1.5, 0.0, 0.0), Vec3::Y);
+        assert!(ray_quad(&off, c, u, v).is_none());
+        let down = Ray::new(Vec3::ZERO, -Vec3::Y);
+        assert!(ray_quad(&down, c, u, v).is_none());
+    }
+}
