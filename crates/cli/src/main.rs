@@ -17,6 +17,7 @@ mod progressive;
 mod provenance;
 mod reached;
 mod reference;
+mod render;
 mod resume;
 mod stats;
 mod summary;
@@ -28,11 +29,10 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use lueur_integrator::{Film, Marching, PixelBounds, RenderOutput, RenderSettings, Strategy};
+use lueur_integrator::{Film, Strategy};
 use lueur_sampling::SamplerKind;
-use lueur_scene::{SceneFileError, parse_scene_with};
+use lueur_scene::SceneFileError;
 
-use fingerprint::Fingerprint;
 use interrupt::Interrupted;
 
 /// Exit status for input the user must fix (scene files, flags), as clap
@@ -248,7 +248,7 @@ impl std::error::Error for BadInput {}
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render(args) => run_render(*args),
+        Command::Render(args) => render::run(*args),
         Command::Points(args) => points::run_points(args),
         Command::Merge(args) => run_merge(args),
         Command::Completions { shell } => {
@@ -287,223 +287,6 @@ fn main() -> ExitCode {
             }
         }
     }
-}
-
-fn run_render(mut args: RenderArgs) -> Result<()> {
-    let file = args.scene.display().to_string();
-    let text = std::fs::read_to_string(&args.scene)
-        .map_err(|e| BadInput(format!("cannot read scene file {file}: {e}")))?;
-    let resumed = match args.resume.clone() {
-        Some(path) => {
-            validate::input("--resume", &path)?;
-            Some(resume::restore(&path, &mut args)?)
-        }
-        None => None,
-    };
-    let overrides: Vec<&str> = args.set.iter().map(String::as_str).collect();
-    let parsed = parse_scene_with(&text, &file, &overrides)?;
-    let scene = parsed.scene;
-    let settings = apply_flags(parsed.settings, &args)?;
-    let range = render_range(&args, &settings)?;
-    let (out, format) = validate::render_outputs(&args)?;
-    let bounds = crop::bounds(
-        args.crop_window.as_deref(),
-        args.pixel_bounds.as_deref(),
-        settings.width,
-        settings.height,
-    )?;
-    let limits = render_limits(&args, out.is_some())?;
-    let mut reference = reference_for(
-        &args,
-        bounds.map_or([settings.width, settings.height], |b| {
-            [b.width(), b.height()]
-        }),
-    )?;
-    progressive::install_signal_handler()?;
-
-    let whole = PixelBounds::whole(settings.width, settings.height);
-    let region = bounds.unwrap_or(whole);
-    let pixels = u64::from(region.width()) * u64::from(region.height());
-    let fingerprint = Fingerprint::of(&settings, bounds, args.sample_range.as_ref(), &args.set);
-    let film = match (&args.resume, &resumed) {
-        (Some(path), Some(resumed)) => {
-            resume::load(path, resumed, &text, &fingerprint, settings.sampler, &range)?
-        }
-        _ => Film::starting_at(region.width(), region.height(), range.start),
-    };
-    let fingerprint = fingerprint.to_string();
-    // Without a checkpoint nobody will extend the film: it can keep one
-    // image instead of one per dyadic block (two at 24 spp, three at 100).
-    let film = match args.checkpoint {
-        Some(_) => film,
-        None => film.sealed_at(range.end),
-    };
-    let bar = bar::Bar::new(
-        pixels * u64::from(range.end - range.start),
-        pixels * u64::from(film.spp().min(range.end - range.start)),
-        limits.time,
-        args.quiet,
-    );
-    let progress = |n: u64| bar.add(n);
-    let mut partial = match (limits.pass_seconds, &out, format) {
-        (Some(every), Some(out), Some(format)) => Some(partial::Partial::new(
-            every,
-            out.clone(),
-            format,
-            args.exposure,
-        )),
-        _ => None,
-    };
-    let started = std::time::Instant::now();
-    let provenance_of = |film: &Film| {
-        provenance::of_render(
-            &file,
-            &text,
-            &settings,
-            film.samples(),
-            started.elapsed().as_secs_f64(),
-            film.relative_error(),
-        )
-    };
-    let mut after_pass = |film: &Film| {
-        if let Some(r) = reference.as_mut() {
-            let e = r.after_pass(film)?;
-            bar::message(&format!(
-                "{} spp: MSE {:.4e} against the reference, estimated {:.4e}; relative MSE {:.4e}",
-                film.spp(),
-                e.mse,
-                e.estimated_mse,
-                e.rel_mse
-            ));
-        }
-        if let Some(path) = &args.checkpoint {
-            checkpoint::save(path, film, &text, &fingerprint)
-                .with_context(|| format!("cannot write checkpoint {}", path.display()))?;
-        }
-        partial
-            .as_mut()
-            .map_or(Ok(()), |p| p.after_pass(film, || provenance_of(film)))
-    };
-    let end = range.end;
-    let run = || {
-        progressive::render(
-            &scene,
-            &settings,
-            region,
-            film,
-            end,
-            limits,
-            &progress,
-            &mut after_pass,
-        )
-    };
-    let (output, stop) = match args.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .context("cannot start the worker threads")?
-            .install(run),
-        None => run(),
-    }?;
-    bar.finish();
-    let output: RenderOutput = output;
-    let interrupted = || Interrupted {
-        spp: output.film.spp(),
-        unfinished: output
-            .film
-            .unfinished_pass()
-            .map(|(samples, share)| (samples.end - output.film.samples().start, share)),
-        out: out.clone().filter(|_| output.film.spp() > 0),
-        checkpoint: args.checkpoint.clone(),
-        scene: args.scene.clone(),
-    };
-    if output.film.spp() == 0 {
-        // Interrupted during the first pass: a partly black image is of no
-        // use to anyone.
-        return Err(interrupted().into());
-    }
-
-    if let (Some(out), Some(format)) = (&out, format) {
-        let provenance = provenance::of_render(
-            &file,
-            &text,
-            &settings,
-            output.film.samples(),
-            output.stats.elapsed.as_secs_f64(),
-            output.film.relative_error(),
-        );
-        output::write_image(out, format, &output.film, args.exposure, &provenance)
-            .with_context(|| format!("cannot write {}", out.display()))?;
-    }
-
-    summary::report(
-        &args,
-        &settings,
-        &output,
-        stop,
-        out.as_deref(),
-        range.end - range.start,
-        &limits,
-    );
-    if stop == progressive::Stop::Interrupted {
-        return Err(interrupted().into());
-    }
-    Ok(())
-}
-
-/// The converged image `--reference` names, checked against the size of what
-/// is rendered (the crop's, where there is one) before the first sample.
-fn reference_for(
-    args: &RenderArgs,
-    [width, height]: [u32; 2],
-) -> Result<Option<reference::Reference>> {
-    args.reference
-        .as_deref()
-        .map(|p| reference::load(p, width, height, args.reference_out.clone()))
-        .transpose()
-        .map_err(|e| BadInput(format!("{e:#}")).into())
-}
-
-/// The sample indices to render: a shard's (`--sample-range`, which needs
-/// a checkpoint to save it in), or all of `0..spp`.
-/// When to stop or cut passes short: --time, --target-error,
-/// --partial-every (which needs an image to write, `has_out`).
-fn render_limits(args: &RenderArgs, has_out: bool) -> Result<progressive::Limits> {
-    if args.threads == Some(0) {
-        bail!(BadInput("--threads must be at least 1".into()));
-    }
-    let limits = progressive::Limits {
-        time: positive(args.time, "--time")?,
-        target_error: positive(args.target_error, "--target-error")?,
-        pass_seconds: positive(args.partial_every, "--partial-every")?,
-    };
-    if limits.pass_seconds.is_some() && !has_out {
-        bail!(BadInput(
-            "--partial-every writes the output image: give it with --out".into()
-        ));
-    }
-    Ok(limits)
-}
-
-fn render_range(args: &RenderArgs, settings: &RenderSettings) -> Result<Range<u32>> {
-    Ok(match &args.sample_range {
-        Some(r) if r.end > settings.spp => {
-            return Err(BadInput(format!(
-                "--sample-range {}..{} ends past the render's {} spp (set the total with --spp)",
-                r.start, r.end, settings.spp
-            ))
-            .into());
-        }
-        Some(_) if args.checkpoint.is_none() => {
-            return Err(BadInput(
-                "--sample-range renders a shard: save it with --checkpoint FILE, for `lueur merge`"
-                    .into(),
-            )
-            .into());
-        }
-        Some(r) => r.clone(),
-        None => 0..settings.spp,
-    })
 }
 
 fn run_merge(args: MergeArgs) -> Result<()> {
@@ -575,51 +358,4 @@ fn run_merge(args: MergeArgs) -> Result<()> {
         );
     }
     Ok(())
-}
-
-fn apply_flags(mut s: RenderSettings, a: &RenderArgs) -> Result<RenderSettings> {
-    if a.naive {
-        s.marching = Marching::Naive;
-    }
-    if let Some(v) = a.spp {
-        s.spp = v;
-    }
-    if let Some(v) = a.strategy {
-        s.strategy = v;
-    }
-    if let Some(v) = a.sampler {
-        s.sampler = v;
-    }
-    if let Some(v) = a.seed {
-        s.seed = v;
-    }
-    if let Some(v) = a.max_depth {
-        s.max_depth = v;
-    }
-    if let Some(v) = a.roulette_depth {
-        s.roulette_depth = v;
-    }
-    if let Some(v) = a.width {
-        s.width = v;
-    }
-    if let Some(v) = a.height {
-        s.height = v;
-    }
-    if let Some(v) = a.replicates {
-        s.replicates = Some(v);
-    }
-    if !a.exposure.is_finite() {
-        bail!(BadInput("--exposure must be finite".into()));
-    }
-    s.validate().map_err(|e| match e {
-        lueur_integrator::RenderError::Replicates(why) => match a.replicates {
-            Some(_) => BadInput(format!("--replicates: {why}")),
-            None => BadInput(format!(
-                "render.replicates of {}: {why} (override it with --replicates)",
-                a.scene.display()
-            )),
-        },
-        e => BadInput(e.to_string()),
-    })?;
-    Ok(s)
 }
