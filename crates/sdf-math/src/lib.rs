@@ -52,6 +52,7 @@ mod prepared;
 mod primitives;
 mod ray;
 mod sdf;
+mod sdf_bounds;
 mod trace;
 
 pub use glam::{Quat, Vec3};
