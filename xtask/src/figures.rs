@@ -214,7 +214,7 @@ pub fn run(quick: bool) -> Result<()> {
         )?;
     }
 
-    // Figure 8: the point sets of lueur-sampling and their spectra.
+    // Figure 8: the point sets of lueur-pointsets and their spectra.
     md.push_str(&pointsets_figure(&dir, &plan.points, flag)?);
 
     // Figure 10: the zsobol sampler's error is blue noise on screen. The

@@ -1,5 +1,5 @@
 //! The point-set figures of `cargo xtask figures`: every generator of
-//! `lueur_sampling::pointsets` as points and power spectrum (Figure 8), and
+//! `lueur_pointsets` as points and power spectrum (Figure 8), and
 //! the screen-space spectrum of the rendering error with the `zsobol`
 //! sampler against `independent` (Figure 10).
 
@@ -9,7 +9,7 @@ use std::path::Path;
 use anyhow::Result;
 use image::RgbImage;
 use lueur::integrator::{RenderSettings, Strategy};
-use lueur::sampling::pointsets::{PointSetKind, generate, radial_power_spectrum};
+use lueur::pointsets::{PointSetKind, generate, radial_power_spectrum};
 use lueur::sampling::{Sampler, SamplerKind};
 use lueur::scene::SceneFile;
 use plotters::style::RGBColor;
@@ -56,9 +56,8 @@ pub fn pointsets_figure(dir: &Path, plan: &PointsPlan, flag: &str) -> Result<Str
     let n = plan.n;
     let sqrt_n = (n as f64).sqrt().round() as usize;
     let half_size = SPECTRUM_EXTENT * sqrt_n;
-    let jobs: Vec<(PointSetKind, u64)> = PointSetKind::ALL
-        .iter()
-        .flat_map(|&k| (0..plan.seeds).map(move |s| (k, s)))
+    let jobs: Vec<(PointSetKind, u64)> = PointSetKind::point_sets()
+        .flat_map(|k| (0..plan.seeds).map(move |s| (k, s)))
         .collect();
     let spectra = jobs
         .par_iter()
@@ -68,7 +67,7 @@ pub fn pointsets_figure(dir: &Path, plan: &PointsPlan, flag: &str) -> Result<Str
         })
         .collect::<Result<Vec<_>>>()?;
     let mut columns = Vec::new();
-    for (i, &kind) in PointSetKind::ALL.iter().enumerate() {
+    for (i, kind) in PointSetKind::point_sets().enumerate() {
         let runs = &spectra[i * plan.seeds as usize..(i + 1) * plan.seeds as usize];
         let power: Vec<f64> = (0..half_size)
             .map(|r| runs.iter().map(|p| p[r]).sum::<f64>() / runs.len() as f64)
@@ -114,7 +113,7 @@ pub fn pointsets_figure(dir: &Path, plan: &PointsPlan, flag: &str) -> Result<Str
     writeln!(
         md,
         "## Figure 8: the point sets and their spectra\n\n![]({file_name})\n\n\
-         Every generator of `lueur_sampling::pointsets` (`generate(kind, {n}, 2, seed)`): above, the \
+         Every generator of `lueur_pointsets` (`generate(kind, {n}, 2, seed)`): above, the \
          {n} points of seed 0 in the unit square; below, their radially averaged power spectrum \
          (`radial_power_spectrum` at the integer frequencies up to {half_size} = {SPECTRUM_EXTENT} \
          sqrt(n) cycles per unit, mean over seeds 0 to {}; log scale, values outside [0.01, 100] \

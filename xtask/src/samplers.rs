@@ -15,8 +15,8 @@ use std::fmt::Write as _;
 
 use anyhow::{Context, Result, bail};
 use lueur::integrator::{RenderSettings, Strategy};
+use lueur::pointsets::least_squares_slope;
 use lueur::sampling::SamplerKind;
-use lueur::sampling::pointsets::least_squares_slope;
 
 use crate::reference::{cache_dir, flatten, reference, render_film};
 use crate::{docs_dir, load_scene};

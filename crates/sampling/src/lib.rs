@@ -62,9 +62,9 @@ mod frame;
 mod light;
 mod math;
 mod mis;
-pub mod pointsets;
 mod quad_light;
 mod sampler;
+mod sampler_kind;
 mod sphere_light;
 mod stats;
 mod warp;
@@ -80,7 +80,8 @@ pub use quad_light::{
     SphericalRectangle, polygon_irradiance, quad_area_pdf, quad_solid_angle_pdf, sample_quad_area,
     sample_quad_solid_angle,
 };
-pub use sampler::{DIMENSIONS_PER_SAMPLE, Sampler, SamplerKind};
+pub use sampler::{DIMENSIONS_PER_SAMPLE, Sampler};
+pub use sampler_kind::SamplerKind;
 pub use sphere_light::{sample_sphere_light, sphere_light_pdf, sphere_solid_angle};
 pub use stats::{
     ChiSquareTest, DirectionBins, MIN_EXPECTED_COUNT, chi_square_p_value, chi_square_test,
