@@ -1,4 +1,5 @@
-use lueur_sampling::{ChiSquareTest, Vec2, Vec3};
+use lueur_sampling::{Vec2, Vec3};
+use lueur_stats::ChiSquareTest;
 use proptest::test_runner::{Config as ProptestConfig, RngSeed};
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::Rng;

@@ -3,7 +3,8 @@
 //! stratified as each kind claims within a pixel, decorrelated between
 //! dimensions and pixels, and ZSobol's pixels complementary.
 
-use lueur_sampling::{Sampler, SamplerKind, Vec2, chi_square_test};
+use lueur_sampling::{Sampler, SamplerKind, Vec2};
+use lueur_stats::chi_square_test;
 
 use crate::common::SIGNIFICANCE;
 use crate::common::assert_0m2_net;
