@@ -215,7 +215,7 @@ fn runs(lueur: &Path, w: u32, h: u32, work: &Path) -> Result<Vec<Run>> {
     ];
     // Four shards of one sample each, then their merge (the measured run).
     for k in 0..4 {
-        let shard = Command::new(&lueur)
+        let shard = Command::new(lueur)
             .current_dir(project_root())
             .args(render(
                 4,

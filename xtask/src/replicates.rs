@@ -167,7 +167,7 @@ pub fn run(quick: bool) -> Result<()> {
         for &sampler in plan.samplers {
             let mut rows = Vec::new();
             for k in COUNTS.iter().copied().filter(|&k| k <= plan.spp) {
-                let row = measure(&plan, scene, sampler, k, &truth)?;
+                let row = measure(plan, scene, sampler, k, &truth)?;
                 eprintln!(
                     "{scene} {sampler} K={k}: MSE {:.3e}, MSE/var {:.2}, z spread {:.2}, var CV {:.2}",
                     row.mse, row.error_over_variance, row.z_spread, row.variance_cv
@@ -177,7 +177,7 @@ pub fn run(quick: bool) -> Result<()> {
             table.push((format!("{scene}, {sampler}"), rows));
         }
     }
-    write_report(&plan, quick, &table)?;
+    write_report(plan, quick, &table)?;
     // The quick figures (12 pixels, 8 seeds) are too noisy to judge by.
     if quick { Ok(()) } else { check_default(&table) }
 }

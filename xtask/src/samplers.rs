@@ -69,14 +69,14 @@ pub fn run(quick: bool, report_only: bool) -> Result<()> {
                 csv_path.display()
             )
         })?;
-        from_csv(&plan, &text)?
+        from_csv(plan, &text)?
     } else {
-        let (table, csv) = measure(&plan)?;
+        let (table, csv) = measure(plan)?;
         std::fs::write(&csv_path, csv)
             .with_context(|| format!("writing {}", csv_path.display()))?;
         table
     };
-    report(&plan, quick, &table)
+    report(plan, quick, &table)
 }
 
 /// A measured table: per scene, its samplers' rows.

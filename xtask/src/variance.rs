@@ -114,7 +114,7 @@ pub fn run(quick: bool) -> Result<()> {
         );
         for (strategy, sampler) in configs {
             for &spp in plan.spps {
-                let row = measure(scene, &file, &plan, &reference, strategy, sampler, spp)?;
+                let row = measure(scene, &file, plan, &reference, strategy, sampler, spp)?;
                 eprintln!(
                     "{scene:>16} {strategy:>8} {sampler:>12} {spp:>4} spp: MSE {:.3e} var {:.3e} bias^2 {:+.2e} {:.2} s",
                     row.mse, row.variance, row.bias2, row.seconds
@@ -124,11 +124,11 @@ pub fn run(quick: bool) -> Result<()> {
         }
     }
 
-    let failures = check_claims(&rows, &plan);
+    let failures = check_claims(&rows, plan);
     let csv_path = cache.join("variance.csv");
     std::fs::write(&csv_path, csv(&rows))
         .with_context(|| format!("writing {}", csv_path.display()))?;
-    let md = markdown(&rows, &plan, quick, &failures)?;
+    let md = markdown(&rows, plan, quick, &failures)?;
     write_report(quick, "VARIANCE.md", &md)?;
     println!("wrote {}", csv_path.display());
     if !failures.is_empty() {
