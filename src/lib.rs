@@ -19,7 +19,11 @@
 /// Signed distance functions and the sphere tracer.
 pub use lueur_sdf_math as sdf_math;
 
-/// Warps, pdfs, MIS weights and point sets.
+/// Point sets in the unit cube, the measures that compare them, and the
+/// registry of kinds.
+pub use lueur_pointsets as pointsets;
+
+/// Warps, pdfs, MIS weights and the renderer's sampler.
 pub use lueur_sampling as sampling;
 
 /// BSDFs: Lambertian and mirror.

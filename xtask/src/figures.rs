@@ -9,11 +9,13 @@ use anyhow::{Context, Result};
 use image::RgbImage;
 use lueur::integrator::{Film, RenderSettings, Strategy};
 use lueur::sampling::SamplerKind;
+use lueur::scene::SceneFile;
 
 use crate::compose::{color_bar, error_map, grid, stack};
 use crate::pointset_figures::{ErrorSpectrumPlan, PointsPlan, pointsets_figure, zsobol_figure};
-use crate::reference::{flatten, reference};
-use crate::{docs_dir, load_scene, render_with_bar};
+use crate::reference::{Reference, flatten, reference};
+use crate::report::{Plans, output_dir, quick_flag, write_report};
+use crate::{load_scene, render_with_bar};
 
 /// The shipped scenes, in the order of the report's figures.
 pub const SCENES: [&str; 3] = ["death-star", "donut-mirrors", "cornell-spheres"];
@@ -32,26 +34,27 @@ struct Plan {
     error_seeds: u64,
 }
 
-const FULL: Plan = Plan {
-    showcase_size: 256,
-    showcase_spp: 256,
-    compare_size: 128,
-    compare_spp: [4, 128],
-    reference_spp: 4096,
-    points: PointsPlan { n: 1024, seeds: 8 },
-    error_spp: 4,
-    error_seeds: 8,
-};
-
-const QUICK: Plan = Plan {
-    showcase_size: 64,
-    showcase_spp: 8,
-    compare_size: 48,
-    compare_spp: [4, 32],
-    reference_spp: 256,
-    points: PointsPlan { n: 256, seeds: 2 },
-    error_spp: 4,
-    error_seeds: 4,
+const PLANS: Plans<Plan> = Plans {
+    full: Plan {
+        showcase_size: 256,
+        showcase_spp: 256,
+        compare_size: 128,
+        compare_spp: [4, 128],
+        reference_spp: 4096,
+        points: PointsPlan { n: 1024, seeds: 8 },
+        error_spp: 4,
+        error_seeds: 8,
+    },
+    quick: Plan {
+        showcase_size: 64,
+        showcase_spp: 8,
+        compare_size: 48,
+        compare_spp: [4, 32],
+        reference_spp: 256,
+        points: PointsPlan { n: 256, seeds: 2 },
+        error_spp: 4,
+        error_seeds: 4,
+    },
 };
 
 /// Relative error shown as the top of the colour scale of error maps.
@@ -61,11 +64,10 @@ const ERROR_FULL_SCALE: f64 = 1.0;
 const ERROR_EPSILON: f64 = 0.01;
 
 pub fn run(quick: bool) -> Result<()> {
-    let plan = if quick { QUICK } else { FULL };
-    let dir = docs_dir(quick).join("figures");
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let plan = PLANS.pick(quick);
+    let dir = output_dir(quick, "figures")?;
     let mut md = String::new();
-    let flag = if quick { " --quick" } else { "" };
+    let flag = quick_flag(quick);
     writeln!(
         md,
         "# Figures\n\nEvery image here is made by `cargo xtask figures{flag}` from the scene files in \
@@ -76,9 +78,44 @@ pub fn run(quick: bool) -> Result<()> {
         plan.reference_spp
     )?;
 
-    // Figures 1 and 2 (and the Cornell example): the shipped scenes with
-    // the default strategy at enough samples to show the scene rather than
-    // the noise; the comparisons below show the noise.
+    showcase(&mut md, plan, &dir)?;
+
+    // Figures 3 to 7: each strategy at two sample counts on the donut, with
+    // error maps against a reference. Independent samples, as in the report:
+    // the differences are then the strategies' alone.
+    let scene = "donut-mirrors";
+    let file = load_scene(scene)?;
+    let size = plan.compare_size;
+    let reference = reference(scene, &file, size, plan.reference_spp)?;
+    let renders = strategy_renders(plan, &dir, &file, &reference)?;
+    strategy_figures(&mut md, plan, &dir, scene, &renders)?;
+
+    // Figure 8: the point sets of lueur-pointsets and their spectra.
+    md.push_str(&pointsets_figure(&dir, &plan.points, flag)?);
+
+    // Figure 10: the zsobol sampler's error is blue noise on screen. The
+    // donut's reference above is reused (same scene and size).
+    md.push_str(&zsobol_figure(
+        &dir,
+        scene,
+        &file,
+        &reference.mean,
+        &ErrorSpectrumPlan {
+            size,
+            spp: plan.error_spp,
+            seeds: plan.error_seeds,
+            reference_spp: plan.reference_spp,
+        },
+        flag,
+    )?);
+    write_report(quick, "FIGURES.md", &md)?;
+    Ok(())
+}
+
+/// Figures 1 and 2 (and the Cornell example): the shipped scenes with the
+/// default strategy at enough samples to show the scene rather than the
+/// noise; the comparisons show the noise.
+fn showcase(md: &mut String, plan: &Plan, dir: &Path) -> Result<()> {
     for (i, name) in SCENES.iter().enumerate() {
         let file = load_scene(name)?;
         let settings = RenderSettings {
@@ -105,15 +142,23 @@ pub fn run(quick: bool) -> Result<()> {
         )?;
     }
 
-    // Figures 3 to 7: each strategy at two sample counts on the donut, with
-    // error maps against a reference. Independent samples, as in the report:
-    // the differences are then the strategies' alone.
-    let scene = "donut-mirrors";
-    let file = load_scene(scene)?;
+    Ok(())
+}
+
+/// One strategy's render at one spp on the donut: its image, its error map
+/// and its mean relative error.
+type StrategyRender = (Strategy, u32, RgbImage, RgbImage, f64);
+
+/// Each strategy at the plan's two sample counts on the donut, independent
+/// samples, saved as PNG, with error maps against `reference`.
+fn strategy_renders(
+    plan: &Plan,
+    dir: &Path,
+    file: &SceneFile,
+    reference: &Reference,
+) -> Result<Vec<StrategyRender>> {
     let size = plan.compare_size;
-    let reference = reference(scene, &file, size, plan.reference_spp)?;
-    let bar = color_bar(size, "0", &format!(">={ERROR_FULL_SCALE}"));
-    let mut renders: Vec<(Strategy, u32, RgbImage, RgbImage, f64)> = Vec::new();
+    let mut renders: Vec<StrategyRender> = Vec::new();
     for strategy in [
         Strategy::Uniform,
         Strategy::Light,
@@ -138,6 +183,20 @@ pub fn run(quick: bool) -> Result<()> {
             renders.push((strategy, spp, img, map, mean_error));
         }
     }
+    Ok(renders)
+}
+
+/// Figures 3 to 7 from the strategy renders: each strategy at two spp, and
+/// all of them side by side at each spp.
+fn strategy_figures(
+    md: &mut String,
+    plan: &Plan,
+    dir: &Path,
+    scene: &str,
+    renders: &[StrategyRender],
+) -> Result<()> {
+    let size = plan.compare_size;
+    let bar = color_bar(size, "0", &format!(">={ERROR_FULL_SCALE}"));
     let cell = |s: Strategy, spp: u32| {
         renders
             .iter()
@@ -214,32 +273,6 @@ pub fn run(quick: bool) -> Result<()> {
         )?;
     }
 
-    // Figure 8: the point sets of lueur-sampling and their spectra.
-    md.push_str(&pointsets_figure(&dir, &plan.points, flag)?);
-
-    // Figure 10: the zsobol sampler's error is blue noise on screen. The
-    // donut's reference above is reused (same scene and size).
-    md.push_str(&zsobol_figure(
-        &dir,
-        scene,
-        &file,
-        &reference.mean,
-        &ErrorSpectrumPlan {
-            size,
-            spp: plan.error_spp,
-            seeds: plan.error_seeds,
-            reference_spp: plan.reference_spp,
-        },
-        flag,
-    )?);
-
-    let md_path = docs_dir(quick).join("FIGURES.md");
-    std::fs::write(&md_path, md).with_context(|| format!("writing {}", md_path.display()))?;
-    eprintln!(
-        "figures written to {} and {}",
-        dir.display(),
-        md_path.display()
-    );
     Ok(())
 }
 

@@ -9,6 +9,7 @@ mod plot;
 mod pointset_figures;
 mod reference;
 mod replicates;
+mod report;
 mod samplers;
 mod scale;
 mod spectrum;

@@ -18,7 +18,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail, ensure};
 
-use crate::{docs_dir, project_root};
+use crate::project_root;
+use crate::report::write_report;
 
 /// The issue's target for a 4K render, film included.
 const TARGET_MB: f64 = 400.0;
@@ -97,6 +98,61 @@ pub fn run(quick: bool) -> Result<()> {
     let lueur = build_lueur()?;
     let (w, h) = if quick { (480, 270) } else { (3840, 2160) };
     let work = scratch_dir()?;
+    let runs = runs(&lueur, w, h, &work)?;
+
+    // The scene's sampler (sobol-xor) deals its samples into the default
+    // number of replicates, each a 28-byte statistic per pixel.
+    let replicates = lueur::integrator::DEFAULT_REPLICATES;
+    let film_mb = 28.0 * f64::from(replicates) * f64::from(w) * f64::from(h) / 1e6;
+    let mut table = String::new();
+    let mut over = Vec::new();
+    writeln!(
+        table,
+        "| run | peak resident | in films of {film_mb:.0} MB | wall time |"
+    )?;
+    writeln!(table, "|---|---|---|---|")?;
+    std::env::set_current_dir(project_root())?;
+    for run in &runs {
+        let (mb, secs) = peak_rss_mb(&lueur, &run.args)?;
+        println!("{:<45} {mb:>7.0} MB  ({secs:.1} s)", run.what);
+        writeln!(
+            table,
+            "| {} | {mb:.0} MB | {:.2} | {secs:.1} s |",
+            run.what,
+            mb / film_mb
+        )?;
+        if run.held_to_target && mb > TARGET_MB && !quick {
+            over.push(format!("{}: {mb:.0} MB", run.what));
+        }
+    }
+    let _ = std::fs::remove_dir_all(&work);
+
+    {
+        let md = format!(
+            "# Memory\n\n\
+             Peak resident memory of `lueur` (release build) on \
+             `{SCENE}` at {w}x{h}, each run in a process of its own \
+             (`getrusage`, as `/usr/bin/time -v` reports it). One film image \
+             is 28 bytes per pixel per replicate; the scene's sampler deals \
+             its samples into {replicates} (the default): {film_mb:.0} MB. Regenerate with \
+             `cargo xtask memory` (about 4 minutes on 2 cores); it fails if \
+             a render passes {TARGET_MB:.0} MB.\n\n{table}\n\
+             The merge holds the merged film, one image per one-bit of its \
+             sample count so far, plus the shard being read: with shards of \
+             one sample, the third shard waits beside `0..2` for the fourth.\n"
+        );
+        write_report(quick, "MEMORY.md", &md)?;
+    }
+    if !over.is_empty() {
+        bail!("over the {TARGET_MB:.0} MB target: {}", over.join("; "));
+    }
+    Ok(())
+}
+
+/// The measured runs at `w` x `h`, files in `work`: plain renders, a
+/// checkpoint and its resume, and the merge of four shards (rendered here,
+/// unmeasured, so that the merge has them).
+fn runs(lueur: &Path, w: u32, h: u32, work: &Path) -> Result<Vec<Run>> {
     let file = |name: &str| work.join(name).display().to_string();
     let size = |spp: u32| {
         vec![
@@ -159,7 +215,7 @@ pub fn run(quick: bool) -> Result<()> {
     ];
     // Four shards of one sample each, then their merge (the measured run).
     for k in 0..4 {
-        let shard = Command::new(&lueur)
+        let shard = Command::new(lueur)
             .current_dir(project_root())
             .args(render(
                 4,
@@ -187,55 +243,7 @@ pub fn run(quick: bool) -> Result<()> {
         held_to_target: false,
     });
 
-    // The scene's sampler (sobol-xor) deals its samples into the default
-    // number of replicates, each a 28-byte statistic per pixel.
-    let replicates = lueur::integrator::DEFAULT_REPLICATES;
-    let film_mb = 28.0 * f64::from(replicates) * f64::from(w) * f64::from(h) / 1e6;
-    let mut table = String::new();
-    let mut over = Vec::new();
-    writeln!(
-        table,
-        "| run | peak resident | in films of {film_mb:.0} MB | wall time |"
-    )?;
-    writeln!(table, "|---|---|---|---|")?;
-    std::env::set_current_dir(project_root())?;
-    for run in &runs {
-        let (mb, secs) = peak_rss_mb(&lueur, &run.args)?;
-        println!("{:<45} {mb:>7.0} MB  ({secs:.1} s)", run.what);
-        writeln!(
-            table,
-            "| {} | {mb:.0} MB | {:.2} | {secs:.1} s |",
-            run.what,
-            mb / film_mb
-        )?;
-        if run.held_to_target && mb > TARGET_MB && !quick {
-            over.push(format!("{}: {mb:.0} MB", run.what));
-        }
-    }
-    let _ = std::fs::remove_dir_all(&work);
-
-    {
-        let md = format!(
-            "# Memory\n\n\
-             Peak resident memory of `lueur` (release build) on \
-             `{SCENE}` at {w}x{h}, each run in a process of its own \
-             (`getrusage`, as `/usr/bin/time -v` reports it). One film image \
-             is 28 bytes per pixel per replicate; the scene's sampler deals \
-             its samples into {replicates} (the default): {film_mb:.0} MB. Regenerate with \
-             `cargo xtask memory` (about 4 minutes on 2 cores); it fails if \
-             a render passes {TARGET_MB:.0} MB.\n\n{table}\n\
-             The merge holds the merged film, one image per one-bit of its \
-             sample count so far, plus the shard being read: with shards of \
-             one sample, the third shard waits beside `0..2` for the fourth.\n"
-        );
-        let path = docs_dir(quick).join("MEMORY.md");
-        std::fs::write(&path, md).with_context(|| format!("writing {}", path.display()))?;
-        println!("wrote {}", path.display());
-    }
-    if !over.is_empty() {
-        bail!("over the {TARGET_MB:.0} MB target: {}", over.join("; "));
-    }
-    Ok(())
+    Ok(runs)
 }
 
 /// A scratch directory under the target directory (4K checkpoints are

@@ -28,9 +28,11 @@ use std::process::Command;
 use anyhow::{Context, Result, bail, ensure};
 use lueur::integrator::{RenderSettings, Strategy};
 use lueur::sampling::SamplerKind;
+use lueur::scene::SceneFile;
 
-use crate::reference::{cache_dir, flatten, render_film};
-use crate::{docs_dir, load_scene, project_root};
+use crate::reference::{Reference, cache_dir, flatten, render_film};
+use crate::report::{Plans, write_report};
+use crate::{load_scene, project_root};
 
 const SCENE: &str = "cornell-spheres";
 const LLVM19: &str = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1";
@@ -47,24 +49,25 @@ struct Plan {
     correctness_spp: u32,
 }
 
-const FULL: Plan = Plan {
-    size: 256,
-    spps: &[4, 16, 64, 256],
-    timed_spp: 64,
-    repeats: 3,
-    reference_passes: 16,
-    reference_pass_spp: 256,
-    correctness_spp: 1024,
-};
-
-const QUICK: Plan = Plan {
-    size: 64,
-    spps: &[4, 16],
-    timed_spp: 16,
-    repeats: 1,
-    reference_passes: 4,
-    reference_pass_spp: 64,
-    correctness_spp: 64,
+const PLANS: Plans<Plan> = Plans {
+    full: Plan {
+        size: 256,
+        spps: &[4, 16, 64, 256],
+        timed_spp: 64,
+        repeats: 3,
+        reference_passes: 16,
+        reference_pass_spp: 256,
+        correctness_spp: 1024,
+    },
+    quick: Plan {
+        size: 64,
+        spps: &[4, 16],
+        timed_spp: 16,
+        repeats: 1,
+        reference_passes: 4,
+        reference_pass_spp: 64,
+        correctness_spp: 64,
+    },
 };
 
 #[derive(Clone, Copy)]
@@ -160,7 +163,7 @@ fn mitsuba(args: &[String]) -> Result<HashMap<String, f64>> {
 }
 
 pub fn run(quick: bool) -> Result<()> {
-    let plan = if quick { &QUICK } else { &FULL };
+    let plan = PLANS.pick(quick);
     let check = python()
         .args(["-c", "import mitsuba"])
         .output()
@@ -172,67 +175,15 @@ pub fn run(quick: bool) -> Result<()> {
     );
     let work = cache_dir()?.join("peers");
     std::fs::create_dir_all(&work)?;
-    // The reference: Mitsuba's fastest variant, independent samples, seeds
-    // far from the measured renders'.
-    let reference_path = work.join(format!("reference-{}px.exr", plan.size));
-    eprintln!(
-        "reference: Mitsuba llvm_ad_rgb, {} passes of {} spp",
-        plan.reference_passes, plan.reference_pass_spp
-    );
-    let mut args = vec!["llvm_ad_rgb".to_string()];
-    args.push(plan.reference_pass_spp.to_string());
-    args.push(reference_path.display().to_string());
-    args.extend([
-        "--passes".into(),
-        plan.reference_passes.to_string(),
-        "--seed".into(),
-        "100000".into(),
-        "--width".into(),
-        plan.size.to_string(),
-        "--height".into(),
-        plan.size.to_string(),
-    ]);
-    // Cached: the reference takes minutes, and is a function of the scene
-    // text, the plan and Mitsuba's version only.
-    let key = format!(
-        "{}\n{} {} {}\n{}",
-        std::fs::read_to_string(scene_path())?,
-        plan.size,
-        plan.reference_passes,
-        plan.reference_pass_spp,
-        mitsuba_version()
-    );
-    let key_path = reference_path.with_extension("key");
-    let cached = std::fs::read_to_string(&key_path).is_ok_and(|k| k == key)
-        && reference_path.with_extension("var.exr").exists();
-    let reference_time = if cached {
-        eprintln!("reference: cached in {}", reference_path.display());
-        f64::NAN
-    } else {
-        let t = mitsuba(&args)?.get("total_s").copied().unwrap_or(f64::NAN);
-        std::fs::write(&key_path, &key)?;
-        t
-    };
+    let (reference_path, reference_time) = mitsuba_reference(plan, &work)?;
     let reference = read_rgb(&reference_path)?;
     let reference_var = read_rgb(&reference_path.with_extension("var.exr"))?;
-    let n = reference.pixels.len() as f64;
-    let reference_noise = reference_var
-        .pixels
-        .iter()
-        .map(|&v| f64::from(v))
-        .sum::<f64>()
-        / n;
-    let mse_of = |img: &[f32]| -> f64 {
-        let raw = img
-            .iter()
-            .zip(&reference.pixels)
-            .map(|(&a, &b)| (f64::from(a) - f64::from(b)).powi(2))
-            .sum::<f64>()
-            / n;
-        raw - reference_noise
-    };
-
     let file = load_scene(SCENE)?;
+    let correctness = correctness(plan, &file, &reference, &reference_var)?;
+    let against = Reference {
+        mean: reference.pixels,
+        var_of_mean: reference_var.pixels,
+    };
     let configs = [
         Config::Lueur(SamplerKind::Independent),
         Config::Lueur(SamplerKind::default()),
@@ -253,9 +204,81 @@ pub fn run(quick: bool) -> Result<()> {
             sampler: "ldsampler",
         },
     ];
-    // Correctness first: independent samples (their standard errors are
-    // honest; a QMC film's overstate the error) at more spp than the
-    // speed series, with another seed.
+    let mut results: Vec<(Config, Vec<Measured>)> = Vec::new();
+    for config in configs {
+        let mut rows = Vec::new();
+        for &spp in plan.spps {
+            let m = measure(plan, &file, &work, &against, config, spp)?;
+            eprintln!(
+                "{:<36} {:>4} spp  {:>7.2} s  MSE {:.3e}",
+                config.name(),
+                spp,
+                m.seconds,
+                m.mse
+            );
+            rows.push(m);
+        }
+        results.push((config, rows));
+    }
+    let md = report(plan, &results, &correctness, reference_time)?;
+    write_report(quick, "PEERS.md", &md)?;
+    Ok(())
+}
+
+/// The reference: Mitsuba's fastest variant, independent samples, seeds far
+/// from the measured renders'. Cached: it takes minutes, and is a function
+/// of the scene text, the plan and Mitsuba's version only. Returns its path
+/// and how long it took (NaN when cached).
+fn mitsuba_reference(plan: &Plan, work: &Path) -> Result<(PathBuf, f64)> {
+    let reference_path = work.join(format!("reference-{}px.exr", plan.size));
+    eprintln!(
+        "reference: Mitsuba llvm_ad_rgb, {} passes of {} spp",
+        plan.reference_passes, plan.reference_pass_spp
+    );
+    let mut args = vec!["llvm_ad_rgb".to_string()];
+    args.push(plan.reference_pass_spp.to_string());
+    args.push(reference_path.display().to_string());
+    args.extend([
+        "--passes".into(),
+        plan.reference_passes.to_string(),
+        "--seed".into(),
+        "100000".into(),
+        "--width".into(),
+        plan.size.to_string(),
+        "--height".into(),
+        plan.size.to_string(),
+    ]);
+    let key = format!(
+        "{}\n{} {} {}\n{}",
+        std::fs::read_to_string(scene_path())?,
+        plan.size,
+        plan.reference_passes,
+        plan.reference_pass_spp,
+        mitsuba_version()
+    );
+    let key_path = reference_path.with_extension("key");
+    let cached = std::fs::read_to_string(&key_path).is_ok_and(|k| k == key)
+        && reference_path.with_extension("var.exr").exists();
+    let reference_time = if cached {
+        eprintln!("reference: cached in {}", reference_path.display());
+        f64::NAN
+    } else {
+        let t = mitsuba(&args)?.get("total_s").copied().unwrap_or(f64::NAN);
+        std::fs::write(&key_path, &key)?;
+        t
+    };
+    Ok((reference_path, reference_time))
+}
+
+/// Correctness first: independent samples (their standard errors are
+/// honest; a QMC film's overstate the error) at more spp than the speed
+/// series, with another seed.
+fn correctness(
+    plan: &Plan,
+    file: &SceneFile,
+    reference: &Rgb,
+    reference_var: &Rgb,
+) -> Result<String> {
     eprintln!(
         "correctness: lueur mis, independent, {} spp",
         plan.correctness_spp
@@ -269,97 +292,85 @@ pub fn run(quick: bool) -> Result<()> {
         seed: 7,
         ..file.settings.clone()
     };
-    let (film, _) = render_film(&file, &settings)?;
-    let correctness = compare(
+    let (film, _) = render_film(file, &settings)?;
+    compare(
         &flatten(&film.mean_image()),
         &film.variance_image(),
-        &reference,
-        &reference_var,
+        reference,
+        reference_var,
         plan.size,
-    )?;
-    drop(film);
+    )
+}
 
-    let mut results: Vec<(Config, Vec<Measured>)> = Vec::new();
-    for config in configs {
-        let mut rows = Vec::new();
-        for &spp in plan.spps {
-            let repeats = if spp == plan.timed_spp {
-                plan.repeats
-            } else {
-                1
-            };
-            let m = match config {
-                Config::Lueur(sampler) => {
-                    let settings = RenderSettings {
-                        width: plan.size,
-                        height: plan.size,
-                        spp,
-                        strategy: Strategy::Mis,
-                        sampler,
-                        ..file.settings.clone()
-                    };
-                    let mut times = Vec::new();
-                    let mut film = None;
-                    for _ in 0..repeats {
-                        let (f, t) = render_film(&file, &settings)?;
-                        times.push(t);
-                        film = Some(f);
-                    }
-                    let film = film.expect("one render");
-                    let img = flatten(&film.mean_image());
-                    Measured {
-                        spp,
-                        seconds: median(times),
-                        first_seconds: None,
-                        mse: mse_of(&img),
-                    }
-                }
-                Config::Mitsuba { variant, sampler } => {
-                    let out = work.join(format!("{variant}-{sampler}-{spp}.exr"));
-                    let mut args = vec![
-                        variant.to_string(),
-                        spp.to_string(),
-                        out.display().to_string(),
-                        "--sampler".into(),
-                        sampler.into(),
-                        "--repeats".into(),
-                        repeats.to_string(),
-                        "--width".into(),
-                        plan.size.to_string(),
-                        "--height".into(),
-                        plan.size.to_string(),
-                    ];
-                    args.extend(["--seed".into(), "0".into()]);
-                    let numbers = mitsuba(&args)?;
-                    let img = read_rgb(&out)?;
-                    Measured {
-                        spp,
-                        seconds: *numbers
-                            .get("warm_s")
-                            .context("no warm_s from mitsuba_render.py")?,
-                        first_seconds: numbers.get("first_s").copied(),
-                        mse: mse_of(&img.pixels),
-                    }
-                }
-            };
-            eprintln!(
-                "{:<36} {:>4} spp  {:>7.2} s  MSE {:.3e}",
-                config.name(),
+/// One configuration at `spp`: its time (the median of `repeats` renders at
+/// the timed spp) and its MSE against the reference.
+fn measure(
+    plan: &Plan,
+    file: &SceneFile,
+    work: &Path,
+    reference: &Reference,
+    config: Config,
+    spp: u32,
+) -> Result<Measured> {
+    let repeats = if spp == plan.timed_spp {
+        plan.repeats
+    } else {
+        1
+    };
+    Ok(match config {
+        Config::Lueur(sampler) => {
+            let settings = RenderSettings {
+                width: plan.size,
+                height: plan.size,
                 spp,
-                m.seconds,
-                m.mse
-            );
-            rows.push(m);
+                strategy: Strategy::Mis,
+                sampler,
+                ..file.settings.clone()
+            };
+            let mut times = Vec::new();
+            let mut film = None;
+            for _ in 0..repeats {
+                let (f, t) = render_film(file, &settings)?;
+                times.push(t);
+                film = Some(f);
+            }
+            let film = film.expect("one render");
+            let img = flatten(&film.mean_image());
+            Measured {
+                spp,
+                seconds: median(times),
+                first_seconds: None,
+                mse: reference.mse(&img),
+            }
         }
-        results.push((config, rows));
-    }
-
-    let md = report(plan, &results, &correctness, reference_time)?;
-    let path = docs_dir(quick).join("PEERS.md");
-    std::fs::create_dir_all(path.parent().expect("a directory"))?;
-    std::fs::write(&path, md).with_context(|| format!("writing {}", path.display()))?;
-    println!("wrote {}", path.display());
-    Ok(())
+        Config::Mitsuba { variant, sampler } => {
+            let out = work.join(format!("{variant}-{sampler}-{spp}.exr"));
+            let mut args = vec![
+                variant.to_string(),
+                spp.to_string(),
+                out.display().to_string(),
+                "--sampler".into(),
+                sampler.into(),
+                "--repeats".into(),
+                repeats.to_string(),
+                "--width".into(),
+                plan.size.to_string(),
+                "--height".into(),
+                plan.size.to_string(),
+            ];
+            args.extend(["--seed".into(), "0".into()]);
+            let numbers = mitsuba(&args)?;
+            let img = read_rgb(&out)?;
+            Measured {
+                spp,
+                seconds: *numbers
+                    .get("warm_s")
+                    .context("no warm_s from mitsuba_render.py")?,
+                first_seconds: numbers.get("first_s").copied(),
+                mse: reference.mse(&img.pixels),
+            }
+        }
+    })
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -520,8 +531,13 @@ fn report(
             )?;
         }
     }
-    // The headline: lueur's default against Mitsuba's fastest, at the timed
-    // spp and at the largest.
+    summary(&mut md, plan, results)?;
+    Ok(md)
+}
+
+/// The headline: lueur's default against Mitsuba's fastest, at every spp
+/// of the series.
+fn summary(md: &mut String, plan: &Plan, results: &[(Config, Vec<Measured>)]) -> Result<()> {
     let find = |pred: &dyn Fn(&Config) -> bool| results.iter().find(|(c, _)| pred(c));
     let lueur = find(&|c| matches!(c, Config::Lueur(s) if *s == SamplerKind::default()));
     let best_mitsuba = results
@@ -555,7 +571,7 @@ fn report(
             }
         }
     }
-    Ok(md)
+    Ok(())
 }
 
 fn mitsuba_version() -> String {

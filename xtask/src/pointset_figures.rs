@@ -1,5 +1,5 @@
 //! The point-set figures of `cargo xtask figures`: every generator of
-//! `lueur_sampling::pointsets` as points and power spectrum (Figure 8), and
+//! `lueur_pointsets` as points and power spectrum (Figure 8), and
 //! the screen-space spectrum of the rendering error with the `zsobol`
 //! sampler against `independent` (Figure 10).
 
@@ -9,7 +9,7 @@ use std::path::Path;
 use anyhow::Result;
 use image::RgbImage;
 use lueur::integrator::{RenderSettings, Strategy};
-use lueur::sampling::pointsets::{PointSetKind, generate, radial_power_spectrum};
+use lueur::pointsets::{PointSetKind, generate, radial_power_spectrum};
 use lueur::sampling::{Sampler, SamplerKind};
 use lueur::scene::SceneFile;
 use plotters::style::RGBColor;
@@ -56,9 +56,8 @@ pub fn pointsets_figure(dir: &Path, plan: &PointsPlan, flag: &str) -> Result<Str
     let n = plan.n;
     let sqrt_n = (n as f64).sqrt().round() as usize;
     let half_size = SPECTRUM_EXTENT * sqrt_n;
-    let jobs: Vec<(PointSetKind, u64)> = PointSetKind::ALL
-        .iter()
-        .flat_map(|&k| (0..plan.seeds).map(move |s| (k, s)))
+    let jobs: Vec<(PointSetKind, u64)> = PointSetKind::point_sets()
+        .flat_map(|k| (0..plan.seeds).map(move |s| (k, s)))
         .collect();
     let spectra = jobs
         .par_iter()
@@ -68,7 +67,7 @@ pub fn pointsets_figure(dir: &Path, plan: &PointsPlan, flag: &str) -> Result<Str
         })
         .collect::<Result<Vec<_>>>()?;
     let mut columns = Vec::new();
-    for (i, &kind) in PointSetKind::ALL.iter().enumerate() {
+    for (i, kind) in PointSetKind::point_sets().enumerate() {
         let runs = &spectra[i * plan.seeds as usize..(i + 1) * plan.seeds as usize];
         let power: Vec<f64> = (0..half_size)
             .map(|r| runs.iter().map(|p| p[r]).sum::<f64>() / runs.len() as f64)
@@ -114,7 +113,7 @@ pub fn pointsets_figure(dir: &Path, plan: &PointsPlan, flag: &str) -> Result<Str
     writeln!(
         md,
         "## Figure 8: the point sets and their spectra\n\n![]({file_name})\n\n\
-         Every generator of `lueur_sampling::pointsets` (`generate(kind, {n}, 2, seed)`): above, the \
+         Every generator of `lueur_pointsets` (`generate(kind, {n}, 2, seed)`): above, the \
          {n} points of seed 0 in the unit square; below, their radially averaged power spectrum \
          (`radial_power_spectrum` at the integer frequencies up to {half_size} = {SPECTRUM_EXTENT} \
          sqrt(n) cycles per unit, mean over seeds 0 to {}; log scale, values outside [0.01, 100] \
@@ -206,43 +205,7 @@ pub fn zsobol_figure(
 ) -> Result<String> {
     let size = plan.size as usize;
     let samplers = [SamplerKind::Independent, SamplerKind::ZSobol];
-    let mut results: Vec<(SamplerKind, Vec<f64>, ImageSpectrum)> = Vec::new();
-    let mut clamped = Vec::new();
-    let mut max_error = 0f64;
-    for sampler in samplers {
-        let mut spectra = Vec::new();
-        let mut first_error = Vec::new();
-        let mut clamped_pixels = 0;
-        for seed in 1..=plan.seeds {
-            // Seeds from 1: the reference is seed 0, and an `independent`
-            // render with its seed would repeat its first samples.
-            let settings = RenderSettings {
-                width: plan.size,
-                height: plan.size,
-                spp: plan.spp,
-                strategy: Strategy::Mis,
-                sampler,
-                seed,
-                ..file.settings.clone()
-            };
-            let (film, _) = render_film(file, &settings)?;
-            let (error, n_clamped, max) = luminance_error(&flatten(&film.mean_image()), reference);
-            clamped_pixels += n_clamped;
-            max_error = max_error.max(max);
-            spectra.push(image_spectrum(&error, size));
-            if seed == 1 {
-                first_error = error;
-            }
-        }
-        eprintln!(
-            "{:>12}: {clamped_pixels} of {} pixel errors clamped to +-{ERROR_CLAMP} \
-             (largest so far {max_error:.2})",
-            sampler.name(),
-            plan.seeds * (size * size) as u64
-        );
-        clamped.push(clamped_pixels);
-        results.push((sampler, first_error, ImageSpectrum::mean(&spectra)));
-    }
+    let (results, clamped, max_error) = render_error_spectra(file, reference, plan, &samplers)?;
     let render = band_ratios(&results[0].2, &results[1].2);
     eprintln!(
         "zsobol / independent error energy, render ({} spp, {} seeds): {:.3} below {} \
@@ -253,20 +216,7 @@ pub fn zsobol_figure(
     // The same comparison where every pixel integrates the same smooth 2D
     // function with its first two dimensions: the case ZSobol's blue noise
     // is built for (Ahmed and Wonka 2020), as a yardstick for the render.
-    let bump_reference = bump_integral();
-    let bump: Vec<(SamplerKind, ImageSpectrum)> = samplers
-        .iter()
-        .map(|&kind| {
-            let spectra: Vec<ImageSpectrum> = (1..=plan.seeds)
-                .map(|seed| {
-                    let error =
-                        pixel_integral_errors(kind, plan.size, plan.spp, seed, bump_reference);
-                    image_spectrum(&error, size)
-                })
-                .collect();
-            (kind, ImageSpectrum::mean(&spectra))
-        })
-        .collect();
+    let bump = integral_error_spectra(plan, &samplers);
     let integral = band_ratios(&bump[0].1, &bump[1].1);
     eprintln!(
         "zsobol / independent error energy, one 2D integral per pixel: {:.3} below {} cycles \
@@ -274,49 +224,7 @@ pub fn zsobol_figure(
         integral.low, integral.low_band, integral.high, integral.total
     );
 
-    // Both error maps on one signed scale: twice the RMS error of the
-    // independent render, so the noise's texture shows, not its outliers.
-    let independent = &results[0].1;
-    let rms = (independent.iter().map(|e| e * e).sum::<f64>() / independent.len() as f64)
-        .sqrt()
-        .max(1e-12);
-    let full_scale = 2.0 * rms;
-    let factor = (256 / plan.size).max(1);
-    let maps: Vec<(String, RgbImage)> = results
-        .iter()
-        .map(|(s, e, _)| {
-            let map = signed_error_map(plan.size, plan.size, e, full_scale);
-            (s.to_string(), enlarge(&map, factor))
-        })
-        .collect();
-    let maps = grid(
-        Some(&format!("Fig. 10: mis, {} spp, luminance error", plan.spp)),
-        &[maps],
-    );
-    let bar = signed_color_bar(
-        plan.size * factor,
-        &format!("-{full_scale:.2}"),
-        &format!("+{full_scale:.2}"),
-    );
-    let width = maps.width() - 12;
-    let render_pairs: Vec<(SamplerKind, &ImageSpectrum)> =
-        results.iter().map(|(k, _, s)| (*k, s)).collect();
-    let bump_pairs: Vec<(SamplerKind, &ImageSpectrum)> =
-        bump.iter().map(|(k, s)| (*k, s)).collect();
-    let plots = grid(
-        None,
-        &[
-            vec![(
-                "spectrum of the render's error".to_owned(),
-                error_spectrum_plot(width, &render_pairs)?,
-            )],
-            vec![(
-                "same 2D integral in every pixel".to_owned(),
-                error_spectrum_plot(width, &bump_pairs)?,
-            )],
-        ],
-    );
-    let fig = stack(&[maps, bar, plots]);
+    let fig = fig10(plan, &results, &bump)?;
     let file_name = "fig10-zsobol-error-spectrum.png";
     save(&fig, &dir.join(file_name))?;
     let mut md = String::new();
@@ -365,6 +273,134 @@ pub fn zsobol_figure(
         },
     )?;
     Ok(md)
+}
+
+/// A sampler's error image of seed 1 and its spectrum averaged over seeds.
+type ErrorSpectra = (SamplerKind, Vec<f64>, ImageSpectrum);
+
+/// Each sampler's render error against `reference`, seeds 1 to
+/// `plan.seeds`: the error image of seed 1, the mean spectrum, and how many
+/// pixel errors were clamped; and the largest error seen.
+fn render_error_spectra(
+    file: &SceneFile,
+    reference: &[f32],
+    plan: &ErrorSpectrumPlan,
+    samplers: &[SamplerKind],
+) -> Result<(Vec<ErrorSpectra>, Vec<u64>, f64)> {
+    let size = plan.size as usize;
+    let mut results: Vec<(SamplerKind, Vec<f64>, ImageSpectrum)> = Vec::new();
+    let mut clamped = Vec::new();
+    let mut max_error = 0f64;
+    for &sampler in samplers {
+        let mut spectra = Vec::new();
+        let mut first_error = Vec::new();
+        let mut clamped_pixels = 0;
+        for seed in 1..=plan.seeds {
+            // Seeds from 1: the reference is seed 0, and an `independent`
+            // render with its seed would repeat its first samples.
+            let settings = RenderSettings {
+                width: plan.size,
+                height: plan.size,
+                spp: plan.spp,
+                strategy: Strategy::Mis,
+                sampler,
+                seed,
+                ..file.settings.clone()
+            };
+            let (film, _) = render_film(file, &settings)?;
+            let (error, n_clamped, max) = luminance_error(&flatten(&film.mean_image()), reference);
+            clamped_pixels += n_clamped;
+            max_error = max_error.max(max);
+            spectra.push(image_spectrum(&error, size));
+            if seed == 1 {
+                first_error = error;
+            }
+        }
+        eprintln!(
+            "{:>12}: {clamped_pixels} of {} pixel errors clamped to +-{ERROR_CLAMP} \
+             (largest so far {max_error:.2})",
+            sampler.name(),
+            plan.seeds * (size * size) as u64
+        );
+        clamped.push(clamped_pixels);
+        results.push((sampler, first_error, ImageSpectrum::mean(&spectra)));
+    }
+    Ok((results, clamped, max_error))
+}
+
+/// The same comparison where every pixel integrates the same smooth 2D
+/// function with its first two dimensions: the case ZSobol's blue noise is
+/// built for (Ahmed and Wonka 2020), as a yardstick for the render.
+fn integral_error_spectra(
+    plan: &ErrorSpectrumPlan,
+    samplers: &[SamplerKind],
+) -> Vec<(SamplerKind, ImageSpectrum)> {
+    let size = plan.size as usize;
+    let bump_reference = bump_integral();
+    samplers
+        .iter()
+        .map(|&kind| {
+            let spectra: Vec<ImageSpectrum> = (1..=plan.seeds)
+                .map(|seed| {
+                    let error =
+                        pixel_integral_errors(kind, plan.size, plan.spp, seed, bump_reference);
+                    image_spectrum(&error, size)
+                })
+                .collect();
+            (kind, ImageSpectrum::mean(&spectra))
+        })
+        .collect()
+}
+
+/// Figure 10's image: both error maps above the two spectra.
+fn fig10(
+    plan: &ErrorSpectrumPlan,
+    results: &[ErrorSpectra],
+    bump: &[(SamplerKind, ImageSpectrum)],
+) -> Result<RgbImage> {
+    // Both error maps on one signed scale: twice the RMS error of the
+    // independent render, so the noise's texture shows, not its outliers.
+    let independent = &results[0].1;
+    let rms = (independent.iter().map(|e| e * e).sum::<f64>() / independent.len() as f64)
+        .sqrt()
+        .max(1e-12);
+    let full_scale = 2.0 * rms;
+    let factor = (256 / plan.size).max(1);
+    let maps: Vec<(String, RgbImage)> = results
+        .iter()
+        .map(|(s, e, _)| {
+            let map = signed_error_map(plan.size, plan.size, e, full_scale);
+            (s.to_string(), enlarge(&map, factor))
+        })
+        .collect();
+    let maps = grid(
+        Some(&format!("Fig. 10: mis, {} spp, luminance error", plan.spp)),
+        &[maps],
+    );
+    let bar = signed_color_bar(
+        plan.size * factor,
+        &format!("-{full_scale:.2}"),
+        &format!("+{full_scale:.2}"),
+    );
+    let width = maps.width() - 12;
+    let render_pairs: Vec<(SamplerKind, &ImageSpectrum)> =
+        results.iter().map(|(k, _, s)| (*k, s)).collect();
+    let bump_pairs: Vec<(SamplerKind, &ImageSpectrum)> =
+        bump.iter().map(|(k, s)| (*k, s)).collect();
+    let plots = grid(
+        None,
+        &[
+            vec![(
+                "spectrum of the render's error".to_owned(),
+                error_spectrum_plot(width, &render_pairs)?,
+            )],
+            vec![(
+                "same 2D integral in every pixel".to_owned(),
+                error_spectrum_plot(width, &bump_pairs)?,
+            )],
+        ],
+    );
+    Ok(stack(&[maps, bar, plots]))
 }
 
 /// Error energy of one spectrum over another's in bands of radii.

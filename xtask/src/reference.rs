@@ -23,6 +23,20 @@ pub struct Reference {
 }
 
 impl Reference {
+    /// The reference's own noise: its variance of the mean averaged over
+    /// pixels and channels. It adds to every squared error measured against
+    /// the reference (its samples are independent of the image's), so
+    /// [`Reference::mse`] takes it off.
+    pub fn noise(&self) -> f64 {
+        self.var_of_mean.iter().map(|&v| f64::from(v)).sum::<f64>() / self.var_of_mean.len() as f64
+    }
+
+    /// The mean squared error of `image` (RGB interleaved, the reference's
+    /// size) against the reference, less the reference's own noise.
+    pub fn mse(&self, image: &[f32]) -> f64 {
+        squared_error(image, &self.mean) / image.len() as f64 - self.noise()
+    }
+
     /// Mean over pixels and channels.
     pub fn image_mean(&self) -> f64 {
         self.mean.iter().map(|&v| f64::from(v)).sum::<f64>() / self.mean.len() as f64
@@ -45,6 +59,15 @@ pub fn render_film(file: &SceneFile, settings: &RenderSettings) -> Result<(Film,
         out.stats.dropped_samples
     );
     Ok((out.film, out.stats.elapsed.as_secs_f64()))
+}
+
+/// The sum over pixels and channels of the squared difference of two
+/// images, in `f64`.
+pub fn squared_error(a: &[f32], b: &[f32]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
+        .sum::<f64>()
 }
 
 /// RGB values of a film's mean image, interleaved.

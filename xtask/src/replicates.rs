@@ -20,8 +20,9 @@ use anyhow::{Result, ensure};
 use lueur::integrator::{DEFAULT_REPLICATES, RenderSettings};
 use lueur::sampling::SamplerKind;
 
+use crate::load_scene;
 use crate::reference::{flatten, reference, render_film};
-use crate::{docs_dir, load_scene};
+use crate::report::{self, Plans, quick_flag};
 
 const SCENES: [&str; 3] = ["cornell-spheres", "death-star", "donut-mirrors"];
 const COUNTS: [u32; 5] = [1, 2, 4, 8, 16];
@@ -34,20 +35,21 @@ struct Plan {
     samplers: &'static [SamplerKind],
 }
 
-const FULL: Plan = Plan {
-    size: 32,
-    spp: 64,
-    seeds: 32,
-    ref_spp: 4096,
-    samplers: &[SamplerKind::SobolXor, SamplerKind::Cmj, SamplerKind::ZSobol],
-};
-
-const QUICK: Plan = Plan {
-    size: 12,
-    spp: 16,
-    seeds: 8,
-    ref_spp: 1024,
-    samplers: &[SamplerKind::SobolXor],
+const PLANS: Plans<Plan> = Plans {
+    full: Plan {
+        size: 32,
+        spp: 64,
+        seeds: 32,
+        ref_spp: 4096,
+        samplers: &[SamplerKind::SobolXor, SamplerKind::Cmj, SamplerKind::ZSobol],
+    },
+    quick: Plan {
+        size: 12,
+        spp: 16,
+        seeds: 8,
+        ref_spp: 1024,
+        samplers: &[SamplerKind::SobolXor],
+    },
 };
 
 /// The figures of one (scene, sampler, K).
@@ -157,7 +159,7 @@ fn check_default(table: &[(String, Vec<(u32, Row)>)]) -> Result<()> {
 }
 
 pub fn run(quick: bool) -> Result<()> {
-    let plan = if quick { QUICK } else { FULL };
+    let plan = PLANS.pick(quick);
     let mut table = Vec::new();
     for scene in SCENES {
         let file = load_scene(scene)?;
@@ -165,7 +167,7 @@ pub fn run(quick: bool) -> Result<()> {
         for &sampler in plan.samplers {
             let mut rows = Vec::new();
             for k in COUNTS.iter().copied().filter(|&k| k <= plan.spp) {
-                let row = measure(&plan, scene, sampler, k, &truth)?;
+                let row = measure(plan, scene, sampler, k, &truth)?;
                 eprintln!(
                     "{scene} {sampler} K={k}: MSE {:.3e}, MSE/var {:.2}, z spread {:.2}, var CV {:.2}",
                     row.mse, row.error_over_variance, row.z_spread, row.variance_cv
@@ -175,7 +177,7 @@ pub fn run(quick: bool) -> Result<()> {
             table.push((format!("{scene}, {sampler}"), rows));
         }
     }
-    write_report(&plan, quick, &table)?;
+    write_report(plan, quick, &table)?;
     // The quick figures (12 pixels, 8 seeds) are too noisy to judge by.
     if quick { Ok(()) } else { check_default(&table) }
 }
@@ -195,7 +197,7 @@ fn write_report(plan: &Plan, quick: bool, table: &[(String, Vec<(u32, Row)>)]) -
         plan.spp,
         plan.seeds,
         plan.ref_spp,
-        if quick { " --quick" } else { "" }
+        quick_flag(quick)
     )?;
     writeln!(
         md,
@@ -263,10 +265,6 @@ fn write_report(plan: &Plan, quick: bool, table: &[(String, Vec<(u32, Row)>)]) -
          the replicates' spread is as honest on average (the MSE / variance \
          column) but not steadier per pixel."
     )?;
-    let dir = docs_dir(quick);
-    std::fs::create_dir_all(&dir)?;
-    let path = dir.join("REPLICATES.md");
-    std::fs::write(&path, md)?;
-    eprintln!("wrote {}", path.display());
+    report::write_report(quick, "REPLICATES.md", &md)?;
     Ok(())
 }

@@ -15,11 +15,12 @@ use std::fmt::Write as _;
 
 use anyhow::{Context, Result, bail};
 use lueur::integrator::{RenderSettings, Strategy};
+use lueur::pointsets::least_squares_slope;
 use lueur::sampling::SamplerKind;
-use lueur::sampling::pointsets::least_squares_slope;
 
-use crate::reference::{cache_dir, flatten, reference, render_film};
-use crate::{docs_dir, load_scene};
+use crate::load_scene;
+use crate::reference::{cache_dir, flatten, reference, render_film, squared_error};
+use crate::report::{Plans, quick_flag, write_report};
 
 const SCENES: [&str; 2] = ["cornell-spheres", "donut-mirrors"];
 
@@ -30,18 +31,19 @@ struct Plan {
     ref_spp: u32,
 }
 
-const FULL: Plan = Plan {
-    size: 64,
-    spps: &[4, 16, 64, 256],
-    k: 4,
-    ref_spp: 4096,
-};
-
-const QUICK: Plan = Plan {
-    size: 24,
-    spps: &[4, 16, 64],
-    k: 3,
-    ref_spp: 1024,
+const PLANS: Plans<Plan> = Plans {
+    full: Plan {
+        size: 64,
+        spps: &[4, 16, 64, 256],
+        k: 4,
+        ref_spp: 4096,
+    },
+    quick: Plan {
+        size: 24,
+        spps: &[4, 16, 64],
+        k: 3,
+        ref_spp: 1024,
+    },
 };
 
 /// A sampler, its MSE at each spp of the plan, and seconds per render at
@@ -54,7 +56,7 @@ const CHOSEN_AT: u32 = 64;
 /// Measures (or, with `report_only`, reads the last measurement's CSV) and
 /// writes the report.
 pub fn run(quick: bool, report_only: bool) -> Result<()> {
-    let plan = if quick { QUICK } else { FULL };
+    let plan = PLANS.pick(quick);
     let csv_path = cache_dir()?.join(if quick {
         "samplers-quick.csv"
     } else {
@@ -67,14 +69,14 @@ pub fn run(quick: bool, report_only: bool) -> Result<()> {
                 csv_path.display()
             )
         })?;
-        from_csv(&plan, &text)?
+        from_csv(plan, &text)?
     } else {
-        let (table, csv) = measure(&plan)?;
+        let (table, csv) = measure(plan)?;
         std::fs::write(&csv_path, csv)
             .with_context(|| format!("writing {}", csv_path.display()))?;
         table
     };
-    report(&plan, quick, &table)
+    report(plan, quick, &table)
 }
 
 /// A measured table: per scene, its samplers' rows.
@@ -117,12 +119,7 @@ fn measure(plan: &Plan) -> Result<(Table, String)> {
         let file = load_scene(scene)?;
         let reference = reference(scene, &file, plan.size, plan.ref_spp)?;
         let n = reference.mean.len() as f64;
-        let ref_noise = reference
-            .var_of_mean
-            .iter()
-            .map(|&v| f64::from(v))
-            .sum::<f64>()
-            / n;
+        let ref_noise = reference.noise();
         let mut rows = Vec::new();
         for &sampler in SamplerKind::ALL {
             let mut mses = Vec::new();
@@ -147,11 +144,7 @@ fn measure(plan: &Plan) -> Result<(Table, String)> {
                     let (film, secs) = render_film(&file, &settings)?;
                     times.push(secs);
                     let img = flatten(&film.mean_image());
-                    sq_err += img
-                        .iter()
-                        .zip(&reference.mean)
-                        .map(|(&x, &r)| (f64::from(x) - f64::from(r)).powi(2))
-                        .sum::<f64>();
+                    sq_err += squared_error(&img, &reference.mean);
                 }
                 let mse = sq_err / (n * f64::from(plan.k)) - ref_noise;
                 times.sort_by(f64::total_cmp);
@@ -187,7 +180,7 @@ fn report(plan: &Plan, quick: bool, table: &Table) -> Result<()> {
          ran: compare them within one run only. Each render is one randomization of its point set \
          (`--replicates 1`): the point sets themselves; dealing the samples into replicates for \
          honest error bars (the default) costs some of the gain, measured in REPLICATES.md.\n",
-        if quick { " --quick" } else { "" },
+        quick_flag(quick),
         plan.size,
         plan.size,
         plan.k,
@@ -259,11 +252,7 @@ fn report(plan: &Plan, quick: bool, table: &Table) -> Result<()> {
             writeln!(md, "- {f}")?;
         }
     }
-    let docs = docs_dir(quick);
-    std::fs::create_dir_all(&docs)?;
-    let md_path = docs.join("SAMPLERS.md");
-    std::fs::write(&md_path, md).with_context(|| format!("writing {}", md_path.display()))?;
-    eprintln!("wrote {}", md_path.display());
+    write_report(quick, "SAMPLERS.md", &md)?;
     if !failures.is_empty() {
         bail!(
             "{} claim(s) failed:\n{}",

@@ -1,6 +1,6 @@
 //! The radially averaged power spectrum of an image: the picture that
 //! tells blue-noise error (little power at low frequencies) from white
-//! noise (flat), as `lueur_sampling::pointsets::radial_power_spectrum`
+//! noise (flat), as `lueur_pointsets::radial_power_spectrum`
 //! does for point sets.
 //!
 //! The image's mean is removed, its 2D DFT taken separably (a plain

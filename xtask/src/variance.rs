@@ -35,8 +35,9 @@ use lueur::integrator::{RenderSettings, Strategy};
 use lueur::sampling::SamplerKind;
 use lueur::scene::SceneFile;
 
+use crate::load_scene;
 use crate::reference::{Reference, cache_dir, flatten, reference, render_film};
-use crate::{docs_dir, load_scene};
+use crate::report::{Plans, quick_flag, write_report};
 
 /// The scenes measured, the first one carrying the report's claims.
 const SCENES: [&str; 3] = ["donut-mirrors", "cornell-spheres", "death-star"];
@@ -52,20 +53,21 @@ struct Plan {
     check_bias: bool,
 }
 
-const FULL: Plan = Plan {
-    size: 64,
-    spps: &[4, 16, 64, 128],
-    k: 4,
-    ref_spp: 4096,
-    check_bias: true,
-};
-
-const QUICK: Plan = Plan {
-    size: 24,
-    spps: &[4, 16, 64],
-    k: 3,
-    ref_spp: 1024,
-    check_bias: false,
+const PLANS: Plans<Plan> = Plans {
+    full: Plan {
+        size: 64,
+        spps: &[4, 16, 64, 128],
+        k: 4,
+        ref_spp: 4096,
+        check_bias: true,
+    },
+    quick: Plan {
+        size: 24,
+        spps: &[4, 16, 64],
+        k: 3,
+        ref_spp: 1024,
+        check_bias: false,
+    },
 };
 
 /// One measured configuration.
@@ -91,7 +93,7 @@ impl Row {
 }
 
 pub fn run(quick: bool) -> Result<()> {
-    let plan = if quick { QUICK } else { FULL };
+    let plan = PLANS.pick(quick);
     let cache = cache_dir()?;
 
     let mut rows = Vec::new();
@@ -112,7 +114,7 @@ pub fn run(quick: bool) -> Result<()> {
         );
         for (strategy, sampler) in configs {
             for &spp in plan.spps {
-                let row = measure(scene, &file, &plan, &reference, strategy, sampler, spp)?;
+                let row = measure(scene, &file, plan, &reference, strategy, sampler, spp)?;
                 eprintln!(
                     "{scene:>16} {strategy:>8} {sampler:>12} {spp:>4} spp: MSE {:.3e} var {:.3e} bias^2 {:+.2e} {:.2} s",
                     row.mse, row.variance, row.bias2, row.seconds
@@ -122,16 +124,13 @@ pub fn run(quick: bool) -> Result<()> {
         }
     }
 
-    let failures = check_claims(&rows, &plan);
+    let failures = check_claims(&rows, plan);
     let csv_path = cache.join("variance.csv");
     std::fs::write(&csv_path, csv(&rows))
         .with_context(|| format!("writing {}", csv_path.display()))?;
-    let md = markdown(&rows, &plan, quick, &failures)?;
-    let docs = docs_dir(quick);
-    std::fs::create_dir_all(&docs).with_context(|| format!("creating {}", docs.display()))?;
-    let md_path = docs.join("VARIANCE.md");
-    std::fs::write(&md_path, &md).with_context(|| format!("writing {}", md_path.display()))?;
-    eprintln!("written {} and {}", md_path.display(), csv_path.display());
+    let md = markdown(&rows, plan, quick, &failures)?;
+    write_report(quick, "VARIANCE.md", &md)?;
+    println!("wrote {}", csv_path.display());
     if !failures.is_empty() {
         bail!("variance claims failed:\n  {}", failures.join("\n  "));
     }
@@ -347,7 +346,7 @@ fn markdown(rows: &[Row], plan: &Plan, quick: bool, failures: &[String]) -> Resu
          MSE = bias² + variance (up to noise); bias² is corrected for the noise of the mean and of the reference, \
          so values within ±(variance / {}) of 0 mean \"no measurable bias\". Times are medians of one render on this \
          machine, shared with whatever else ran, so compare them within one run only. Efficiency = 1 / (MSE × time).\n",
-        if quick { " --quick" } else { "" },
+        quick_flag(quick),
         plan.size,
         plan.size,
         plan.k,

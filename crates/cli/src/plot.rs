@@ -7,7 +7,7 @@ use std::path::Path;
 
 use anyhow::Result;
 use image::{GrayImage, Luma};
-use lueur_sampling::pointsets::PointSet;
+use lueur_pointsets::PointSet;
 
 /// Side of the PNG, in pixels.
 pub const PLOT_SIZE: u32 = 512;

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use lueur_sampling::pointsets::{
+use lueur_pointsets::{
     IntegrandFamily, PointSet, PointSetKind, centered_l2_discrepancy, generate, integration_mse,
     l2_star_discrepancy, star_discrepancy_2d, wraparound_l2_discrepancy,
 };
@@ -53,8 +53,9 @@ pub struct PointsArgs {
 }
 
 fn parse_kind(s: &str) -> Result<PointSetKind, String> {
-    PointSetKind::from_name(s).ok_or_else(|| {
-        let all: Vec<_> = PointSetKind::ALL.iter().map(|k| k.name()).collect();
+    let kind = PointSetKind::from_name(s).filter(PointSetKind::is_point_set);
+    kind.ok_or_else(|| {
+        let all: Vec<_> = PointSetKind::point_sets().map(|k| k.name()).collect();
         let hint = if s.eq_ignore_ascii_case("zsobol") {
             " (zsobol orders samples across pixels: it exists only in the renderer)"
         } else {

@@ -6,7 +6,7 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use lueur_sampling::pointsets::sobol_owen_u32;
+use lueur_pointsets::sobol_owen_u32;
 use lueur_sampling::{Sampler, SamplerKind};
 
 /// Nanoseconds per call of `f` over `2^16` indices and 4 dimensions, best of

@@ -1,8 +1,9 @@
 //! Monte Carlo sampling for lueur: warps from uniform numbers to directions
 //! with their pdfs, light-sampling geometry (sphere and quad lights), MIS
 //! weights, discrete distributions for light selection, the renderer-side
-//! deterministic [`Sampler`], and the chi-square machinery that checks all of
-//! the above.
+//! deterministic [`Sampler`]. The chi-square machinery that checks all of
+//! the above is the dev-only crate `lueur-stats`; the point sets the sampler
+//! draws from are `lueur-pointsets`.
 //!
 //! The design decision that shapes it (from pbrt-v4): every routine takes
 //! uniform numbers `u` in `[0, 1)`, never a random number generator, and
@@ -62,11 +63,10 @@ mod frame;
 mod light;
 mod math;
 mod mis;
-pub mod pointsets;
 mod quad_light;
 mod sampler;
+mod sampler_kind;
 mod sphere_light;
-mod stats;
 mod warp;
 
 pub use glam::{Vec2, Vec3};
@@ -80,12 +80,9 @@ pub use quad_light::{
     SphericalRectangle, polygon_irradiance, quad_area_pdf, quad_solid_angle_pdf, sample_quad_area,
     sample_quad_solid_angle,
 };
-pub use sampler::{DIMENSIONS_PER_SAMPLE, Sampler, SamplerKind};
+pub use sampler::{DIMENSIONS_PER_SAMPLE, Sampler};
+pub use sampler_kind::SamplerKind;
 pub use sphere_light::{sample_sphere_light, sphere_light_pdf, sphere_solid_angle};
-pub use stats::{
-    ChiSquareTest, DirectionBins, MIN_EXPECTED_COUNT, chi_square_p_value, chi_square_test,
-    ln_gamma, regularized_gamma_p, regularized_gamma_q,
-};
 pub use warp::{
     cosine_hemisphere_pdf, invert_cosine_hemisphere, invert_uniform_cone,
     invert_uniform_disk_concentric, invert_uniform_hemisphere, invert_uniform_sphere,

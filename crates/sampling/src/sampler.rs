@@ -1,160 +1,19 @@
 //! The renderer-side sampler: uniform numbers as a pure function of
 //! (seed, pixel, sample index, dimension).
 
-use std::fmt;
-
 use glam::Vec2;
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::Rng;
 
-use crate::pointsets::{
-    HALTON_MAX_DIMENSIONS, PMJ02_TABLE_LEN, PMJ02_TABLES, SOBOL_MAX_DIMENSIONS, cmj, halton_base,
-    hash2, hash3, nested_uniform_scramble, owen_scrambled_radical_inverse, permute,
-    pmj02_table_point, radical_inverse, sobol_u32,
+use lueur_pointsets::construct::{
+    PMJ02_TABLE_LEN, PMJ02_TABLES, cmj, hash2, hash3, permute, pmj02_table_point,
+};
+use lueur_pointsets::{
+    HALTON_MAX_DIMENSIONS, SOBOL_MAX_DIMENSIONS, halton_base, nested_uniform_scramble,
+    owen_scrambled_radical_inverse, radical_inverse, sobol_u32,
 };
 
-/// Which point set a [`Sampler`] draws from. An enum, dispatched by `match`,
-/// because the set is closed and the call is in the innermost loop.
-///
-/// Except for the plain constructions ([`SamplerKind::Halton`],
-/// [`SamplerKind::Sobol`]), every kind is randomized per pixel and per
-/// dimension, and "padded" like pbrt-v4's samplers: each 1D or 2D request
-/// is a fresh low-dimensional pattern over the pixel's sample indices,
-/// decorrelated from the other requests by a scramble seed and an index
-/// shuffle hashed from (seed, pixel, dimension), so that high dimensions do
-/// not alias with low ones.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
-pub enum SamplerKind {
-    /// Independent uniform numbers from PCG32 (pbrt-v4 §8.3,
-    /// `IndependentSampler`).
-    Independent,
-    /// Jittered sampling over the pixel's `spp` samples: a 2D request is one
-    /// point per cell of the most square `columns x rows = spp` grid, a 1D
-    /// request one per `1/spp` stratum; sample indices are assigned to
-    /// strata by a random permutation per (pixel, dimension) (pbrt-v4 §8.5).
-    Stratified,
-    /// Latin hypercube over the pixel's `spp` samples (McKay, Beckman and
-    /// Conover 1979): one sample per `1/spp` stratum in every dimension.
-    Lhs,
-    /// Correlated multi-jittered 2D patterns of `spp` points (Kensler 2013),
-    /// one pattern per (pixel, dimension); 1D requests as
-    /// [`SamplerKind::Stratified`].
-    Cmj,
-    /// The plain Halton sequence over sample indices, dimension `k` in the
-    /// `k`-th prime base (wrapping after 1024), the same in every pixel.
-    /// Unrandomized: its errors are correlated across pixels; here to be
-    /// measured, not to be used.
-    Halton,
-    /// Halton, Owen-scrambled (nested random digit permutations) with a seed
-    /// per (pixel, dimension).
-    HaltonOwen,
-    /// The plain Sobol' sequence over sample indices, dimension `k` of the
-    /// Joe–Kuo table (wrapping after 256), the same in every pixel.
-    /// Unrandomized, like [`SamplerKind::Halton`].
-    Sobol,
-    /// Sobol' (0, 2)-sequence per request, randomized by a digital XOR shift
-    /// and an Owen-scrambled index shuffle per (pixel, dimension).
-    ///
-    /// The default: the lowest image MSE measured at 64 and 256 spp on the
-    /// shipped scenes (`cargo xtask samplers`, docs/SAMPLERS.md), tied with
-    /// `cmj`, and unlike `cmj` a sequence, so a render can be resumed or
-    /// stopped by a time budget at any spp without losing its quality.
-    #[default]
-    SobolXor,
-    /// Burley 2020's padded Owen-scrambled Sobol': each request is the first
-    /// two Sobol' dimensions (a (0, 2)-sequence), Owen-scrambled with seeds
-    /// hashed from (seed, pixel, dimension), its index shuffled by an Owen
-    /// scramble, which keeps power-of-two prefixes (0, m, 2)-nets.
-    SobolOwen,
-    /// pbrt-v4's `ZSobolSampler` (Ahmed and Wonka 2020, "Screen-space blue
-    /// noise sampling by ordered dithering"; pbrt-v4 §8.7.7): one global
-    /// Owen-scrambled Sobol' sequence indexed by the Morton code of the pixel
-    /// followed by the sample index, with base-4 digits randomly permuted,
-    /// so neighbouring pixels get complementary points and the image error
-    /// is blue noise.
-    ZSobol,
-    /// Roberts's R2 Kronecker sequence for 2D requests and the golden-ratio
-    /// sequence for 1D requests, with a Cranley–Patterson rotation per
-    /// (pixel, dimension).
-    R2,
-    /// Progressive multi-jittered (0, 2) sequences (Christensen, Kensler and
-    /// Kilpatrick 2018): each request reads one of a few shared pmj02 tables
-    /// at the pixel's sample index, chosen and randomized by a digital (XOR)
-    /// shift per (pixel, dimension), which keeps every power-of-two prefix
-    /// a (0, m, 2)-net, like pbrt-v4's `PMJ02BNSampler` (without its blue-
-    /// noise pixel ordering). 1D requests take the x coordinate, a
-    /// stratified (0, 1)-sequence. Tables hold 4096 samples; past them (or
-    /// past `spp`), a new independent block starts.
-    Pmj02,
-}
-
-impl SamplerKind {
-    /// Every kind, in a stable order.
-    pub const ALL: &'static [SamplerKind] = &[
-        SamplerKind::Independent,
-        SamplerKind::Stratified,
-        SamplerKind::Lhs,
-        SamplerKind::Cmj,
-        SamplerKind::Halton,
-        SamplerKind::HaltonOwen,
-        SamplerKind::Sobol,
-        SamplerKind::SobolXor,
-        SamplerKind::SobolOwen,
-        SamplerKind::ZSobol,
-        SamplerKind::R2,
-        SamplerKind::Pmj02,
-    ];
-
-    /// Whether a sample's value depends on the render's total spp: the
-    /// patterns laid out over `spp` points (stratified, Latin hypercube,
-    /// CMJ) and ZSobol's Morton index. Such a render can only be resumed or
-    /// sharded with the same total spp; the sequences can be extended.
-    pub fn depends_on_spp(&self) -> bool {
-        matches!(
-            self,
-            SamplerKind::Stratified | SamplerKind::Lhs | SamplerKind::Cmj | SamplerKind::ZSobol
-        )
-    }
-
-    /// Whether the kind is randomized (every kind but the plain Halton and
-    /// Sobol' sequences): only then does a different seed give an
-    /// independent point set, which is what replicates are made of.
-    pub fn is_randomized(&self) -> bool {
-        !matches!(self, SamplerKind::Halton | SamplerKind::Sobol)
-    }
-
-    /// The lowercase name used on command lines and in scene files.
-    pub fn name(&self) -> &'static str {
-        match self {
-            SamplerKind::Independent => "independent",
-            SamplerKind::Stratified => "stratified",
-            SamplerKind::Lhs => "lhs",
-            SamplerKind::Cmj => "cmj",
-            SamplerKind::Halton => "halton",
-            SamplerKind::HaltonOwen => "halton-owen",
-            SamplerKind::Sobol => "sobol",
-            SamplerKind::SobolXor => "sobol-xor",
-            SamplerKind::SobolOwen => "sobol-owen",
-            SamplerKind::ZSobol => "zsobol",
-            SamplerKind::R2 => "r2",
-            SamplerKind::Pmj02 => "pmj02",
-        }
-    }
-
-    /// The kind called `s` (ASCII case-insensitive), if any.
-    pub fn from_name(s: &str) -> Option<Self> {
-        Self::ALL
-            .iter()
-            .copied()
-            .find(|kind| kind.name().eq_ignore_ascii_case(s))
-    }
-}
-
-impl fmt::Display for SamplerKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
+use crate::SamplerKind;
 
 /// Dimensions reserved per sample index: the PCG stream position of
 /// `(sample_index, dimension)` is `sample_index * 65536 + dimension`, as in
@@ -465,7 +324,7 @@ impl Sampler {
     fn stratified_1d(&self) -> f32 {
         let h = self.request_hash();
         let stratum = permute(self.index_in_pattern(), self.spp, h as u32);
-        let jitter = crate::pointsets::kensler_unit(stratum, (h >> 32) as u32);
+        let jitter = lueur_pointsets::construct::kensler_unit(stratum, (h >> 32) as u32);
         unit_to_f32((f64::from(stratum) + jitter) / f64::from(self.spp))
     }
 
@@ -494,15 +353,16 @@ impl Sampler {
             SamplerKind::Stratified => {
                 let h = self.request_hash();
                 let j = permute(self.index_in_pattern(), self.spp, h as u32);
-                let [x, y] = crate::pointsets::jittered_2d(j as usize, self.spp as usize, h);
+                let [x, y] =
+                    lueur_pointsets::construct::jittered_2d(j as usize, self.spp as usize, h);
                 Vec2::new(unit_to_f32(x), unit_to_f32(y))
             }
             SamplerKind::Lhs => {
                 let h = self.request_hash();
                 let (i, n) = (self.index_in_pattern() as usize, self.spp as usize);
                 Vec2::new(
-                    unit_to_f32(crate::pointsets::latin_hypercube(i, n, 0, h)),
-                    unit_to_f32(crate::pointsets::latin_hypercube(i, n, 1, h)),
+                    unit_to_f32(lueur_pointsets::construct::latin_hypercube(i, n, 0, h)),
+                    unit_to_f32(lueur_pointsets::construct::latin_hypercube(i, n, 1, h)),
                 )
             }
             SamplerKind::Cmj => {
@@ -617,7 +477,7 @@ impl Sampler {
 
 /// R2's increments `1/phi_2` and `1/phi_2^2` (`phi_2 = 1.3247179572...`,
 /// the plastic number) as 64-bit fractions, computed to 60 digits (the
-/// unit tests check them against [`crate::pointsets`]' Newton iteration).
+/// unit tests check them against `lueur_pointsets`' Newton iteration).
 const R2_INCREMENTS: [u64; 2] = [0xc13f_a9a9_02a6_328f, 0x91e1_0da5_c79e_7b1c];
 
 #[cfg(test)]
@@ -663,7 +523,7 @@ mod tests {
 
     #[test]
     fn kronecker_constants_match_newton() {
-        let [x, y] = crate::pointsets::kronecker_increments(2)[..] else {
+        let [x, y] = lueur_pointsets::construct::kronecker_increments(2)[..] else {
             panic!("two increments");
         };
         // The f64 route has 53 significant bits; the constants 64.
@@ -673,7 +533,7 @@ mod tests {
                 "{constant:#x} {newton:#x}"
             );
         }
-        let golden = crate::pointsets::kronecker_increments(1)[0];
+        let golden = lueur_pointsets::construct::kronecker_increments(1)[0];
         assert!(GOLDEN_1D.abs_diff(golden) < 1 << 12);
     }
 

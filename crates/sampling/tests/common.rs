@@ -1,4 +1,5 @@
-use lueur_sampling::{ChiSquareTest, Vec2, Vec3};
+use lueur_sampling::{Vec2, Vec3};
+use lueur_stats::ChiSquareTest;
 use proptest::test_runner::{Config as ProptestConfig, RngSeed};
 use rand_pcg::Pcg32;
 use rand_pcg::rand_core::Rng;
@@ -140,5 +141,23 @@ impl QuadBins {
             }
         }
         counts
+    }
+}
+
+/// Every elementary interval `[i/2^k, (i+1)/2^k) x [j/2^(m-k), (j+1)/2^(m-k))`
+/// holds exactly one of the `2^m` points: a (0, m, 2)-net in base 2.
+pub fn assert_0m2_net(points: &[[f64; 2]], m: u32, what: &str) {
+    assert_eq!(points.len(), 1 << m, "{what}");
+    for k in 0..=m {
+        let (cols, rows) = (1usize << k, 1usize << (m - k));
+        let mut count = vec![0u32; cols * rows];
+        for p in points {
+            let (cx, cy) = ((p[0] * cols as f64) as usize, (p[1] * rows as f64) as usize);
+            count[cy * cols + cx] += 1;
+        }
+        assert!(
+            count.iter().all(|&c| c == 1),
+            "{what}: m = {m}, intervals {cols}x{rows} not all filled once"
+        );
     }
 }

@@ -1,4 +1,5 @@
-use lueur_sampling::{DiscreteDistribution, ONE_MINUS_EPSILON, chi_square_test};
+use lueur_sampling::{DiscreteDistribution, ONE_MINUS_EPSILON};
+use lueur_stats::chi_square_test;
 use proptest::prelude::*;
 
 use crate::common::{N_SAMPLES, Uniforms, assert_fits, proptest_config};

@@ -1,9 +1,10 @@
 use glam::DVec3;
 use lueur_sampling::{
-    DirectionBins, DirectionSample, Frame, SphericalRectangle, Vec2, Vec3, chi_square_test,
-    polygon_irradiance, quad_area_pdf, quad_solid_angle_pdf, sample_quad_area, sample_sphere_light,
-    sphere_light_pdf, sphere_solid_angle,
+    DirectionSample, Frame, SphericalRectangle, Vec2, Vec3, polygon_irradiance, quad_area_pdf,
+    quad_solid_angle_pdf, sample_quad_area, sample_sphere_light, sphere_light_pdf,
+    sphere_solid_angle,
 };
+use lueur_stats::{DirectionBins, chi_square_test};
 
 use crate::common::{N_PHI, N_SAMPLES, N_Z, QuadBins, SUB, Uniforms, assert_fits, directions};
 

@@ -5,10 +5,10 @@
 //! with `--nocapture`, to show where the power ends.
 
 use lueur_sampling::{
-    ChiSquareTest, DirectionBins, SphericalRectangle, Vec3, chi_square_test, cosine_hemisphere_pdf,
-    quad_solid_angle_pdf, sample_cosine_hemisphere, sample_sphere_light, sample_uniform_hemisphere,
-    sphere_light_pdf,
+    SphericalRectangle, Vec3, cosine_hemisphere_pdf, quad_solid_angle_pdf,
+    sample_cosine_hemisphere, sample_sphere_light, sample_uniform_hemisphere, sphere_light_pdf,
 };
+use lueur_stats::{ChiSquareTest, DirectionBins, chi_square_test};
 
 use crate::common::{N_PHI, N_SAMPLES, N_Z, QuadBins, SIGNIFICANCE, SUB, assert_fits, directions};
 

@@ -1,4 +1,5 @@
-use lueur_sampling::{Sampler, SamplerKind, Vec2, chi_square_test};
+use lueur_sampling::{Sampler, SamplerKind, Vec2};
+use lueur_stats::chi_square_test;
 
 use crate::common::assert_fits;
 

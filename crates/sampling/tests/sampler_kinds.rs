@@ -3,10 +3,11 @@
 //! stratified as each kind claims within a pixel, decorrelated between
 //! dimensions and pixels, and ZSobol's pixels complementary.
 
-use lueur_sampling::{Sampler, SamplerKind, Vec2, chi_square_test};
+use lueur_sampling::{Sampler, SamplerKind, Vec2};
+use lueur_stats::chi_square_test;
 
 use crate::common::SIGNIFICANCE;
-use crate::pointsets::assert_0m2_net;
+use crate::common::assert_0m2_net;
 
 const RESOLUTION: [u32; 2] = [64, 48];
 
@@ -264,4 +265,70 @@ fn randomized_kinds_are_uniform_across_pixels_and_decorrelated_across_dimensions
             );
         }
     }
+}
+
+/// In the renderer, each pixel's samples form a net in every dimension
+/// pair, for every power-of-two spp up to 2^10.
+#[test]
+fn sampler_gives_each_pixel_a_net() {
+    for m in 0..=10u32 {
+        for pixel in [[0, 0], [5, 3], [63, 47]] {
+            for dimension in [0, 2, 7] {
+                let mut sampler = Sampler::for_image(SamplerKind::Pmj02, 9, [64, 48], 1 << m);
+                let points: Vec<[f64; 2]> = (0..1u32 << m)
+                    .map(|i| {
+                        sampler.start_pixel_sample(pixel, i, dimension);
+                        let u = sampler.next_2d();
+                        [f64::from(u.x), f64::from(u.y)]
+                    })
+                    .collect();
+                assert_0m2_net(
+                    &points,
+                    m,
+                    &format!("pmj02 pixel {pixel:?} dim {dimension}"),
+                );
+            }
+        }
+    }
+}
+
+/// The renderer's kinds are the registry's (`lueur-pointsets`), in its
+/// order, with its names: every construction the sampler can draw from one
+/// sample at a time, which is every one but Poisson-disk sets. `listed` is
+/// an exhaustive match (no `_` arm), so a new sampler kind does not compile
+/// until it is checked against the list here.
+#[test]
+fn sampler_kinds_are_the_registrys() {
+    use lueur_pointsets::PointSetKind;
+    let expected: Vec<SamplerKind> = PointSetKind::ALL
+        .iter()
+        .filter(|&&k| k != PointSetKind::PoissonDisk)
+        .map(|&k| SamplerKind::from_point_set(k).expect("a renderer kind"))
+        .collect();
+    assert_eq!(SamplerKind::ALL, expected.as_slice());
+    assert_eq!(SamplerKind::from_point_set(PointSetKind::PoissonDisk), None);
+    fn listed(kind: SamplerKind) -> bool {
+        match kind {
+            SamplerKind::Independent
+            | SamplerKind::Stratified
+            | SamplerKind::Lhs
+            | SamplerKind::Cmj
+            | SamplerKind::Halton
+            | SamplerKind::HaltonOwen
+            | SamplerKind::Sobol
+            | SamplerKind::SobolXor
+            | SamplerKind::SobolOwen
+            | SamplerKind::ZSobol
+            | SamplerKind::R2
+            | SamplerKind::Pmj02 => SamplerKind::ALL.contains(&kind),
+        }
+    }
+    for &kind in SamplerKind::ALL {
+        assert!(listed(kind));
+        assert_eq!(SamplerKind::from_point_set(kind.point_set()), Some(kind));
+        assert_eq!(kind.name(), kind.point_set().name());
+        assert_eq!(SamplerKind::from_name(kind.name()), Some(kind));
+    }
+    assert_eq!(SamplerKind::ALL.len(), 12);
+    assert_eq!(SamplerKind::from_name("poisson-disk"), None);
 }

@@ -31,23 +31,7 @@ mod mis;
 /// values.
 mod sampler;
 
-/// The point-set library: generators in [0, 1), nets and strata, published
-/// Sobol' and Halton points, discrepancies against closed forms and SciPy.
-mod pointsets;
-
 /// Every kind of the renderer's sampler: determinism in any order, nets and
-/// strata per pixel, decorrelated dimensions, ZSobol's complementary pixels.
+/// strata per pixel (pmj02's nets up to 2^10 spp), decorrelated dimensions,
+/// ZSobol's complementary pixels.
 mod sampler_kinds;
-
-/// Integration error as UTK measures it: MSE over randomizations for
-/// Gaussian, half-plane and disk integrands, convergence slopes per kind,
-/// and UTK's published magnitudes for jittered points.
-mod integration_error;
-
-/// The radially averaged power spectrum: flat for independent points, blue
-/// for jittered and Poisson-disk points.
-mod spectrum;
-
-/// pmj02 sequences: power-of-two prefixes are (0, m, 2)-nets, power-of-four
-/// prefixes jittered grids, per pixel in the sampler too.
-mod pmj02;

@@ -1,8 +1,9 @@
 use lueur_sampling::{
-    DirectionBins, Vec2, Vec3, cosine_hemisphere_pdf, sample_cosine_hemisphere,
-    sample_uniform_cone, sample_uniform_hemisphere, sample_uniform_sphere, uniform_cone_pdf,
-    uniform_hemisphere_pdf, uniform_sphere_pdf,
+    Vec2, Vec3, cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_cone,
+    sample_uniform_hemisphere, sample_uniform_sphere, uniform_cone_pdf, uniform_hemisphere_pdf,
+    uniform_sphere_pdf,
 };
+use lueur_stats::DirectionBins;
 
 use crate::common::{N_PHI, N_Z, SUB, assert_fits, directions};
 

@@ -30,7 +30,7 @@ pub fn generalized_golden_ratio(d: usize) -> f64 {
 /// fractions, so that `s + i a` is computed exactly modulo 1 by wrapping
 /// integer arithmetic (a float `i * a` would lose the low bits of the
 /// fractional part as `i` grows).
-pub(crate) fn increments(d: usize) -> Vec<u64> {
+pub fn increments(d: usize) -> Vec<u64> {
     let phi = generalized_golden_ratio(d);
     (1..=d)
         .map(|j| {

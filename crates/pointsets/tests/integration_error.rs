@@ -10,7 +10,7 @@
 //! a correct generator may sit from the theoretical rate over this range of
 //! n, not a p-value. `--nocapture` prints the measured curves.
 
-use lueur_sampling::pointsets::{
+use lueur_pointsets::{
     Convergence, IntegrandFamily, PointSetError, PointSetKind, convergence_slope, integration_mse,
 };
 

@@ -3,7 +3,7 @@
 //! strata, rows and columns); plain Sobol' and Halton reproduce published
 //! points; the discrepancies match closed forms and SciPy.
 
-use lueur_sampling::pointsets::{
+use lueur_pointsets::{
     HALTON_MAX_DIMENSIONS, PointSet, PointSetError, PointSetKind, SOBOL_MAX_DIMENSIONS,
     centered_l2_discrepancy, generate, l2_star_discrepancy, poisson_disk_max_radius,
     radical_inverse, sobol_u32, star_discrepancy_2d, strata_shape, toroidal_distance,
@@ -60,7 +60,7 @@ fn assert_one_per_cell(points: &[[f64; 2]], cols: usize, rows: usize, what: &str
 
 #[test]
 fn every_kind_stays_in_the_unit_cube_and_is_reproducible() {
-    for &kind in PointSetKind::ALL {
+    for kind in PointSetKind::point_sets() {
         for &dim in dims_for(kind) {
             for n in [0, 1, 7, 64, 100] {
                 let a = generate(kind, n, dim, 11).unwrap();
@@ -99,7 +99,53 @@ fn names_round_trip() {
         PointSetKind::from_name("Sobol-Owen"),
         Some(PointSetKind::SobolOwen)
     );
-    assert_eq!(PointSetKind::from_name("zsobol"), None);
+    // ZSobol is in the registry (a kind of the renderer's sampler) but is no
+    // point set of its own: `generate` refuses it by name.
+    assert_eq!(
+        PointSetKind::from_name("zsobol"),
+        Some(PointSetKind::ZSobol)
+    );
+    assert!(!PointSetKind::ZSobol.is_point_set());
+    assert_eq!(
+        generate(PointSetKind::ZSobol, 16, 2, 0),
+        Err(PointSetError::NotAPointSet {
+            kind: PointSetKind::ZSobol
+        })
+    );
+    assert!(PointSetKind::point_sets().all(|k| k != PointSetKind::ZSobol));
+}
+
+/// The registry is complete: `position` is an exhaustive match (no `_`
+/// arm), so a new kind does not compile until it is given a place here, and
+/// then this fails until it is in `ALL`, once, at that place, with a name
+/// of its own.
+#[test]
+fn the_registry_lists_every_kind_once() {
+    fn position(kind: PointSetKind) -> usize {
+        match kind {
+            PointSetKind::Independent => 0,
+            PointSetKind::Stratified => 1,
+            PointSetKind::LatinHypercube => 2,
+            PointSetKind::Cmj => 3,
+            PointSetKind::Halton => 4,
+            PointSetKind::HaltonOwen => 5,
+            PointSetKind::Sobol => 6,
+            PointSetKind::SobolXor => 7,
+            PointSetKind::SobolOwen => 8,
+            PointSetKind::ZSobol => 9,
+            PointSetKind::R2 => 10,
+            PointSetKind::PoissonDisk => 11,
+            PointSetKind::Pmj02 => 12,
+        }
+    }
+    assert_eq!(PointSetKind::ALL.len(), 13);
+    for (i, &kind) in PointSetKind::ALL.iter().enumerate() {
+        assert_eq!(position(kind), i, "{kind}");
+    }
+    let mut names: Vec<_> = PointSetKind::ALL.iter().map(|k| k.name()).collect();
+    names.sort_unstable();
+    names.dedup();
+    assert_eq!(names.len(), PointSetKind::ALL.len(), "names are unique");
 }
 
 #[test]
@@ -530,7 +576,7 @@ fn structured_sets_beat_independent_points() {
     let n = 256;
     let random = measure(PointSetKind::Independent, n);
     eprintln!("n = {n}: kind, L2-star, CD, WD, star");
-    for &kind in PointSetKind::ALL {
+    for kind in PointSetKind::point_sets() {
         let m = measure(kind, n);
         eprintln!(
             "{kind:>12} {:.3e} {:.3e} {:.3e} {:.3e}",

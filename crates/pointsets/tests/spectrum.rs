@@ -1,7 +1,7 @@
 //! The radially averaged power spectrum: flat for independent points,
 //! low at low frequencies for jittered and Poisson-disk points (blue noise).
 
-use lueur_sampling::pointsets::{PointSetKind, RadialSpectrum, generate, radial_power_spectrum};
+use lueur_pointsets::{PointSetKind, RadialSpectrum, generate, radial_power_spectrum};
 
 /// The spectrum of `n` points of `kind`, averaged over `seeds` seeds.
 fn mean_spectrum(kind: PointSetKind, n: usize, half_size: usize, seeds: u64) -> RadialSpectrum {

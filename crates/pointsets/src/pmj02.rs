@@ -273,9 +273,9 @@ impl Builder {
 
 /// How many shared tables the renderer's sampler draws from, and their
 /// length: enough for 4096 samples per pixel before a new block starts.
-pub(crate) const PMJ02_TABLES: usize = 16;
+pub const PMJ02_TABLES: usize = 16;
 /// Points per shared table.
-pub(crate) const PMJ02_TABLE_LEN: usize = 4096;
+pub const PMJ02_TABLE_LEN: usize = 4096;
 
 /// The shared pmj02 tables of the sampler, built on first use (a few
 /// milliseconds each).
@@ -288,7 +288,7 @@ static TABLES: LazyLock<Vec<Vec<[u32; 2]>>> = LazyLock::new(|| {
 /// Point `index` (`< PMJ02_TABLE_LEN`) of shared table `table`
 /// (`< PMJ02_TABLES`).
 #[inline]
-pub(crate) fn pmj02_table_point(table: usize, index: usize) -> [u32; 2] {
+pub fn pmj02_table_point(table: usize, index: usize) -> [u32; 2] {
     TABLES[table][index]
 }
 

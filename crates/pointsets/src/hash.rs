@@ -20,13 +20,13 @@ pub(crate) fn mix64(mut z: u64) -> u64 {
 /// general, so `(seed, dimension)` and `(dimension, seed)` give different
 /// streams.
 #[inline]
-pub(crate) fn hash2(a: u64, b: u64) -> u64 {
+pub fn hash2(a: u64, b: u64) -> u64 {
     mix64(a ^ mix64(b.wrapping_add(GOLDEN_GAMMA)))
 }
 
 /// Hash of three words.
 #[inline]
-pub(crate) fn hash3(a: u64, b: u64, c: u64) -> u64 {
+pub fn hash3(a: u64, b: u64, c: u64) -> u64 {
     hash2(hash2(a, b), c)
 }
 
@@ -53,7 +53,7 @@ pub(crate) const ONE_MINUS_EPSILON_F64: f64 = 1.0 - f64::EPSILON / 2.0;
 /// two `>= len` (each step is invertible on the masked bits), restricted to
 /// `0..len` by cycle walking. Requires `i < len`; `len >= 1`.
 #[inline]
-pub(crate) fn permute(mut i: u32, len: u32, pattern: u32) -> u32 {
+pub fn permute(mut i: u32, len: u32, pattern: u32) -> u32 {
     debug_assert!(len >= 1 && i < len);
     if len == 1 {
         return 0;
@@ -96,7 +96,7 @@ pub(crate) fn permute(mut i: u32, len: u32, pattern: u32) -> u32 {
 /// A uniform number in `[0, 1)` for index `i` of pattern `pattern`
 /// (Kensler 2013, `randfloat()`), as 32 bits over `2^32`.
 #[inline]
-pub(crate) fn kensler_unit(mut i: u32, pattern: u32) -> f64 {
+pub fn kensler_unit(mut i: u32, pattern: u32) -> f64 {
     let p = pattern;
     i ^= p;
     i ^= i >> 17;

@@ -1,18 +1,31 @@
-//! Point sets in the unit cube `[0, 1)^d`, reusable on their own: random,
-//! stratified, low-discrepancy and blue-noise generators behind one call,
-//! [`generate`], and the measures that compare them (L2 discrepancies, the
-//! exact 2D star discrepancy, integration error and its convergence rate
-//! as UTK measures it, and the radially averaged power spectrum).
+//! lueur-pointsets: point sets in the unit cube `[0, 1)^d`, reusable on
+//! their own. Random, stratified, low-discrepancy and blue-noise generators
+//! behind one call, [`generate`], which returns a [`PointSet`] (the primary
+//! type: `n` points of `dim` coordinates, row-major), and the measures that
+//! compare them: L2 discrepancies, the exact 2D star discrepancy,
+//! integration error and its convergence rate as UTK measures it, and the
+//! radially averaged power spectrum.
+//!
+//! [`PointSetKind`] is the one registry of constructions in lueur: their
+//! names, their limits, and which of them [`generate`] can build. The
+//! renderer's per-(pixel, sample, dimension) sampler, in `lueur-sampling`,
+//! draws from the same constructions ([`construct`]) and takes its kinds and
+//! names from this registry.
+//!
+//! What it is not: no rendering, no `f32` vectors, no I/O, no printing; it
+//! does not know pixels (the screen-space ordering of
+//! [`PointSetKind::ZSobol`] is the sampler's alone).
 //!
 //! The design decision: every coordinate is a pure function of (kind, seed,
 //! point index, dimension), computed from integer hashes or from the
 //! point's index, never from a generator's running state (the only
 //! exceptions are [`PointSetKind::Independent`], a PCG32 stream, and
 //! [`PointSetKind::PoissonDisk`] and [`PointSetKind::Pmj02`], whose points
-//! depend on each other by construction). That is what lets the renderer's `Sampler` ask for sample
-//! `i` of a pixel in any order, and what makes randomizations independent:
-//! two seeds give two independent randomizations of the same construction,
-//! over which errors can be averaged.
+//! depend on each other by construction). That is what lets the renderer's
+//! sampler ask for sample `i` of a pixel in any order, and what makes
+//! randomizations independent: two seeds give two independent
+//! randomizations of the same construction, over which errors can be
+//! averaged.
 //!
 //! **Contract.** [`generate`] returns exactly `n` points of `dim`
 //! coordinates, each in `[0, 1)` (never 1), the same ones for the same
@@ -20,13 +33,15 @@
 //! cannot make that many points or dimensions.
 //!
 //! ```
-//! use lueur_sampling::pointsets::{PointSetKind, generate, l2_star_discrepancy};
+//! use lueur_pointsets::{PointSetKind, generate, l2_star_discrepancy};
 //!
 //! let sobol = generate(PointSetKind::SobolOwen, 256, 2, 7).unwrap();
 //! let random = generate(PointSetKind::Independent, 256, 2, 7).unwrap();
 //! assert_eq!(sobol.point(3).len(), 2);
 //! assert!(l2_star_discrepancy(&sobol) < l2_star_discrepancy(&random));
 //! ```
+
+#![deny(missing_docs)]
 
 use std::fmt;
 
@@ -64,97 +79,117 @@ pub use sobol::{
 pub use spectrum::{RadialSpectrum, radial_power_spectrum};
 pub use stratified::strata_shape;
 
-pub(crate) use hash::{hash2, hash3, kensler_unit, permute};
-#[cfg(test)]
-pub(crate) use kronecker::increments as kronecker_increments;
-pub(crate) use pmj02::{PMJ02_TABLE_LEN, PMJ02_TABLES, pmj02_table_point};
-pub(crate) use stratified::{cmj, jittered_2d, latin_hypercube};
+/// The per-point constructions that [`generate`] builds on and that the
+/// renderer's sampler (`lueur-sampling`) calls one sample at a time: integer
+/// hashes, Kensler's permutation and jitter, jittered, Latin hypercube and
+/// CMJ strata, the shared pmj02 tables, Kronecker increments. They live here,
+/// with the point sets, so that the sampler and the point sets are the same
+/// constructions by definition, and dependencies point one way (the sampler
+/// depends on this crate, never the reverse).
+pub mod construct {
+    pub use super::hash::{hash2, hash3, kensler_unit, permute};
+    pub use super::kronecker::increments as kronecker_increments;
+    pub use super::pmj02::{PMJ02_TABLE_LEN, PMJ02_TABLES, pmj02_table_point};
+    pub use super::stratified::{cmj, jittered_2d, latin_hypercube};
+}
 
-use hash::{u32_to_unit, u64_to_unit};
+use hash::{hash2, permute, u32_to_unit, u64_to_unit};
+use stratified::cmj;
 
-/// The generators. An enum, dispatched by `match`: the set is closed and
-/// each kind is one algorithm.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum PointSetKind {
+/// Declares [`PointSetKind`] and its list and names from one table, so that
+/// [`PointSetKind::ALL`] holds every variant by construction: a kind cannot
+/// be added without its name, nor left out of the list.
+macro_rules! kinds {
+    ($($(#[$doc:meta])* $kind:ident => $name:literal,)*) => {
+        /// The registry of constructions: every random, stratified,
+        /// low-discrepancy and blue-noise construction in lueur, whether
+        /// [`generate`] builds it as a point set or the renderer's sampler
+        /// draws from it per pixel (`lueur-sampling`'s `SamplerKind` is the
+        /// renderer's view of this list). An enum, dispatched by `match`: the
+        /// set is closed and each kind is one algorithm.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum PointSetKind {
+            $($(#[$doc])* $kind,)*
+        }
+
+        impl PointSetKind {
+            /// Every kind, in a stable order.
+            pub const ALL: &'static [PointSetKind] = &[$(PointSetKind::$kind,)*];
+
+            /// The lowercase name used on command lines and in scene files,
+            /// by the point sets and the renderer's sampler alike.
+            pub const fn name(&self) -> &'static str {
+                match self {
+                    $(PointSetKind::$kind => $name,)*
+                }
+            }
+        }
+    };
+}
+
+kinds! {
     /// Independent uniform points from PCG32 (O'Neill 2014, "PCG: A family of
     /// simple fast space-efficient statistically good algorithms for random
     /// number generation"). The baseline every other kind is measured
     /// against.
-    Independent,
+    Independent => "independent",
     /// Jittered (stratified) sampling: one point uniformly in each cell of a
     /// [`strata_shape`] grid. Dimensions are paired, `(0, 1)`, `(2, 3)`...,
     /// each pair an independent jittered pattern whose points are shuffled
     /// by a random permutation (padding, as pbrt-v4 §8.5 does), and an odd
     /// last dimension is a shuffled 1D jitter.
-    Stratified,
+    Stratified => "stratified",
     /// Latin hypercube sampling (McKay, Beckman and Conover 1979): in every
     /// dimension, each of the `n` strata holds one point.
-    LatinHypercube,
+    LatinHypercube => "lhs",
     /// Correlated multi-jittered sampling (Kensler 2013), padded by pairs
     /// like [`PointSetKind::Stratified`], each pair its own pattern.
-    Cmj,
+    Cmj => "cmj",
     /// The Halton sequence: radical inverses in the first primes (Halton
     /// 1960), unscrambled; starts at the origin. Seed ignored.
-    Halton,
+    Halton => "halton",
     /// Halton with nested (Owen) random digit permutations per dimension.
-    HaltonOwen,
+    HaltonOwen => "halton-owen",
     /// The Sobol' sequence with Joe–Kuo direction numbers, unscrambled, in
     /// natural order; starts at the origin. Seed ignored.
-    Sobol,
+    Sobol => "sobol",
     /// Sobol' with a random digital shift: every coordinate XORed with a
     /// per-dimension random 32-bit word (a (t, m, s)-net stays one).
-    SobolXor,
+    SobolXor => "sobol-xor",
     /// Sobol' with hash-based nested uniform (Owen) scrambling per
     /// dimension (Burley 2020).
-    SobolOwen,
+    SobolOwen => "sobol-owen",
+    /// pbrt-v4's `ZSobolSampler` (Ahmed and Wonka 2020, "Screen-space blue
+    /// noise sampling by ordered dithering"): one global Owen-scrambled
+    /// Sobol' sequence indexed by the Morton code of the pixel followed by the
+    /// sample index. A screen-space ordering across an image's pixels, so a
+    /// kind of the renderer's sampler only: [`generate`] refuses it.
+    ZSobol => "zsobol",
     /// The rank-1 Kronecker sequence R_d (Roberts 2018; "R2" in 2D) with a
     /// random Cranley–Patterson rotation.
-    R2,
+    R2 => "r2",
     /// A 2D Poisson-disk set by relaxation dart throwing on the torus
     /// (McCool and Fiume 1992): blue noise. 2D only.
-    PoissonDisk,
+    PoissonDisk => "poisson-disk",
     /// Progressive multi-jittered (0, 2) sequences (Christensen, Kensler
     /// and Kilpatrick 2018): every power-of-two prefix is a (0, m, 2)-net
     /// and every power-of-four prefix a jittered grid. A 2D construction,
     /// padded by pairs like [`PointSetKind::Stratified`], each pair its own
     /// sequence, the pairs after the first shuffled.
-    Pmj02,
+    Pmj02 => "pmj02",
 }
 
 impl PointSetKind {
-    /// Every kind, in a stable order.
-    pub const ALL: &'static [PointSetKind] = &[
-        PointSetKind::Independent,
-        PointSetKind::Stratified,
-        PointSetKind::LatinHypercube,
-        PointSetKind::Cmj,
-        PointSetKind::Halton,
-        PointSetKind::HaltonOwen,
-        PointSetKind::Sobol,
-        PointSetKind::SobolXor,
-        PointSetKind::SobolOwen,
-        PointSetKind::R2,
-        PointSetKind::PoissonDisk,
-        PointSetKind::Pmj02,
-    ];
+    /// Whether [`generate`] can build this kind as a point set of its own
+    /// (every kind but [`PointSetKind::ZSobol`], which orders samples across
+    /// an image's pixels).
+    pub fn is_point_set(&self) -> bool {
+        !matches!(self, PointSetKind::ZSobol)
+    }
 
-    /// The lowercase name used on command lines (the renderer's
-    /// `SamplerKind` uses the same names for the kinds it shares).
-    pub fn name(&self) -> &'static str {
-        match self {
-            PointSetKind::Independent => "independent",
-            PointSetKind::Stratified => "stratified",
-            PointSetKind::LatinHypercube => "lhs",
-            PointSetKind::Cmj => "cmj",
-            PointSetKind::Halton => "halton",
-            PointSetKind::HaltonOwen => "halton-owen",
-            PointSetKind::Sobol => "sobol",
-            PointSetKind::SobolXor => "sobol-xor",
-            PointSetKind::SobolOwen => "sobol-owen",
-            PointSetKind::R2 => "r2",
-            PointSetKind::PoissonDisk => "poisson-disk",
-            PointSetKind::Pmj02 => "pmj02",
-        }
+    /// The kinds [`generate`] can build, in the order of [`PointSetKind::ALL`].
+    pub fn point_sets() -> impl Iterator<Item = PointSetKind> {
+        Self::ALL.iter().copied().filter(PointSetKind::is_point_set)
     }
 
     /// The kind called `s` (ASCII case-insensitive), if any.
@@ -169,9 +204,10 @@ impl PointSetKind {
     pub fn max_dimensions(&self) -> Option<usize> {
         match self {
             PointSetKind::Halton | PointSetKind::HaltonOwen => Some(HALTON_MAX_DIMENSIONS),
-            PointSetKind::Sobol | PointSetKind::SobolXor | PointSetKind::SobolOwen => {
-                Some(SOBOL_MAX_DIMENSIONS)
-            }
+            PointSetKind::Sobol
+            | PointSetKind::SobolXor
+            | PointSetKind::SobolOwen
+            | PointSetKind::ZSobol => Some(SOBOL_MAX_DIMENSIONS),
             PointSetKind::PoissonDisk => Some(2),
             _ => None,
         }
@@ -185,6 +221,7 @@ impl PointSetKind {
             PointSetKind::Sobol
             | PointSetKind::SobolXor
             | PointSetKind::SobolOwen
+            | PointSetKind::ZSobol
             | PointSetKind::LatinHypercube
             | PointSetKind::Cmj
             | PointSetKind::Stratified => Some(1 << 32),
@@ -227,6 +264,12 @@ pub enum PointSetError {
         dim: usize,
         /// The dimensions it supports, in words.
         supported: &'static str,
+    },
+    /// A kind of the renderer's sampler only, not a point set of its own.
+    #[error("{kind} orders samples across an image's pixels: it is a sampler, not a point set")]
+    NotAPointSet {
+        /// The kind asked for.
+        kind: PointSetKind,
     },
     /// More points than the kind can index.
     #[error("{kind} supports at most {max} points, {n} were asked")]
@@ -343,6 +386,9 @@ pub fn generate(
 ) -> Result<PointSet, PointSetError> {
     if dim == 0 {
         return Err(PointSetError::ZeroDimensions);
+    }
+    if !kind.is_point_set() {
+        return Err(PointSetError::NotAPointSet { kind });
     }
     if let Some(max) = kind.max_dimensions() {
         if kind == PointSetKind::PoissonDisk && dim != 2 {
@@ -466,6 +512,7 @@ pub fn generate(
                 }
             }
         }
+        PointSetKind::ZSobol => return Err(PointSetError::NotAPointSet { kind }),
         PointSetKind::PoissonDisk => {
             for (i, p) in poisson::poisson_disk_2d(n, seed).into_iter().enumerate() {
                 data[2 * i] = p[0];

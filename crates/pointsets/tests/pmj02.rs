@@ -1,8 +1,8 @@
 //! pmj02: every power-of-two prefix is a (0, m, 2)-net, every power-of-four
-//! prefix a jittered grid, for the point sets and per pixel in the sampler.
+//! prefix a jittered grid, in every dimension pair of the point sets (the
+//! sampler's per-pixel nets are tested in lueur-sampling).
 
-use lueur_sampling::pointsets::{PointSetKind, generate, pmj02_u32};
-use lueur_sampling::{Sampler, SamplerKind};
+use lueur_pointsets::{PointSetKind, generate, pmj02_u32};
 
 use crate::pointsets::assert_0m2_net;
 
@@ -56,30 +56,5 @@ fn point_set_pairs_are_nets() {
         let cell = (p[4] * 256.0) as usize;
         assert!(!seen[cell], "stratum {cell} twice");
         seen[cell] = true;
-    }
-}
-
-/// In the renderer, each pixel's samples form a net in every dimension
-/// pair, for every power-of-two spp up to 2^10.
-#[test]
-fn sampler_gives_each_pixel_a_net() {
-    for m in 0..=10u32 {
-        for pixel in [[0, 0], [5, 3], [63, 47]] {
-            for dimension in [0, 2, 7] {
-                let mut sampler = Sampler::for_image(SamplerKind::Pmj02, 9, [64, 48], 1 << m);
-                let points: Vec<[f64; 2]> = (0..1u32 << m)
-                    .map(|i| {
-                        sampler.start_pixel_sample(pixel, i, dimension);
-                        let u = sampler.next_2d();
-                        [f64::from(u.x), f64::from(u.y)]
-                    })
-                    .collect();
-                assert_0m2_net(
-                    &points,
-                    m,
-                    &format!("pmj02 pixel {pixel:?} dim {dimension}"),
-                );
-            }
-        }
     }
 }

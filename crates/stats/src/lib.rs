@@ -1,15 +1,42 @@
-//! Goodness-of-fit machinery for checking that a warp's samples follow its
-//! pdf: Pearson's chi-square test with pooling of sparse bins, its p-value
-//! through the regularised incomplete gamma function, and equal-solid-angle
-//! binning of directions. Here, rather than in a test helper, because every
-//! crate that samples directions (BSDFs included) owes the same check
-//! (Mitsuba's `chi2` module and pbrt-v4's `bsdfs_test.cpp` do the same).
+//! lueur-stats: the goodness-of-fit machinery that checks that a sampler's
+//! samples follow the pdf it reports. Pearson's chi-square test with pooling
+//! of sparse bins ([`chi_square_test`], whose outcome is the primary type,
+//! [`ChiSquareTest`]), its p-value through the regularised incomplete gamma
+//! function, and equal-solid-angle binning of directions
+//! ([`DirectionBins`]), as Mitsuba's `chi2` module and pbrt-v4's
+//! `bsdfs_test.cpp` do.
+//!
+//! What it is not: part of the renderer. It is a dev-only helper
+//! (`publish = false`, used only in `[dev-dependencies]`), shared by every
+//! crate whose tests owe the same check (warps and lights in
+//! `lueur-sampling`, strategies in `lueur-integrator`); no renderer crate
+//! depends on it. Its unit tests hold it to closed forms; `statrs` would give the gamma functions but not the pooling nor
+//! the direction bins, and is not in the dependency tree.
+//!
+//! ```
+//! use lueur_stats::{DirectionBins, chi_square_test};
+//! use glam::Vec3;
+//!
+//! // Counts that match their expectation are accepted...
+//! let fit = chi_square_test(&[98.0, 103.0, 99.0], &[100.0, 100.0, 100.0]);
+//! assert!(fit.accepts(0.01));
+//! // ...counts far from it are not.
+//! assert!(!chi_square_test(&[150.0, 50.0, 100.0], &[100.0, 100.0, 100.0]).accepts(0.01));
+//!
+//! // Equal-solid-angle bins over the hemisphere around +z.
+//! let bins = DirectionBins::new(Vec3::Z, 0.0, 4, 8);
+//! assert_eq!(bins.len(), 32);
+//! assert!(bins.bin(Vec3::new(0.0, 0.0, 1.0)).is_some());
+//! assert!(bins.bin(Vec3::new(0.0, 0.0, -1.0)).is_none());
+//! ```
+
+#![deny(missing_docs)]
 
 use std::f64::consts::TAU;
 
 use glam::{DVec3, Vec3};
 
-use crate::frame::Frame;
+use lueur_sampling::Frame;
 
 /// Natural log of the gamma function for `x > 0`, by the Lanczos
 /// approximation with `g = 7`, 9 coefficients (Numerical Recipes, 3rd ed.,

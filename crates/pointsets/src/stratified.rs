@@ -30,7 +30,7 @@ pub fn strata_shape(n: usize) -> [usize; 2] {
 /// Point `i` (`i < n`) of a jittered 2D pattern of `n` points: stratum `i`
 /// of the [`strata_shape`] grid, in row-major order, jittered uniformly
 /// inside it by hashes of `(seed, i)`.
-pub(crate) fn jittered_2d(i: usize, n: usize, seed: u64) -> [f64; 2] {
+pub fn jittered_2d(i: usize, n: usize, seed: u64) -> [f64; 2] {
     let [columns, rows] = strata_shape(n);
     let (cx, cy) = (i % columns, i / columns);
     let jx = u64_to_unit(hash3(seed, i as u64, 0));
@@ -53,7 +53,7 @@ pub(crate) fn jittered_1d(i: usize, n: usize, seed: u64) -> f64 {
 /// pattern whose strata are assigned to points by an independent random
 /// permutation, so every row and every column holds exactly one point.
 /// `n <= 2^32`.
-pub(crate) fn latin_hypercube(i: usize, n: usize, dimension: usize, seed: u64) -> f64 {
+pub fn latin_hypercube(i: usize, n: usize, dimension: usize, seed: u64) -> f64 {
     let dim_seed = hash3(seed, dimension as u64, 0x004c_4853);
     let stratum = permute(i as u32, n as u32, dim_seed as u32) as usize;
     jittered_1d(stratum, n, dim_seed)
@@ -69,7 +69,7 @@ pub(crate) fn latin_hypercube(i: usize, n: usize, dimension: usize, seed: u64) -
 /// permutation per row and one per column ("correlated"), which keeps the
 /// pattern close to a jittered grid while lowering its discrepancy.
 /// `1 <= n <= 2^32`, `s < n`.
-pub(crate) fn cmj(s: u32, n: u32, pattern: u32) -> [f64; 2] {
+pub fn cmj(s: u32, n: u32, pattern: u32) -> [f64; 2] {
     let m = ((f64::from(n)).sqrt() as u32).max(1);
     let rows = n.div_ceil(m);
     let s = permute(s, n, pattern.wrapping_mul(0x5163_3e2d));
