@@ -386,11 +386,11 @@ impl fmt::Display for Strategy {
 mod tests {
     //! Each strategy's directions against the pdf it reports: Pearson's
     //! chi-square in equal-solid-angle bins over the hemisphere of the
-    //! normal (`lueur_sampling::DirectionBins`), after checking that the pdf
+    //! normal (`lueur_stats::DirectionBins`), after checking that the pdf
     //! each sample reports is the strategy's pdf at its direction.
     use super::*;
     use crate::{Camera, Light, QuadSampling};
-    use lueur_sampling::DirectionBins;
+    use lueur_stats::DirectionBins;
 
     const N_SAMPLES: usize = 200_000;
     const N_Z: usize = 16;
