@@ -52,7 +52,7 @@ mod scene;
 mod strategy;
 
 pub use camera::Camera;
-pub use film::{Film, FilmError, PixelStats, dyadic_blocks, is_dyadic};
+pub use film::{BlockSlots, Film, FilmError, PixelStats, SlotFill, dyadic_blocks, is_dyadic};
 pub use path::RayCounters;
 pub use render::{
     Pass, PixelBounds, RenderOutput, RenderSettings, RenderStats, render, render_pass,
