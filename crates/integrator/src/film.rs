@@ -211,9 +211,9 @@ struct UnfinishedPass {
 /// row-major, row 0 at the top.
 ///
 /// Passes are merged in tile by tile as the tiles finish (the film never
-/// exists twice: at 4K one image of statistics is 232 MB). So a cancelled
-/// pass leaves the tiles it finished with its samples and the others
-/// without: an *unfinished* film, which can be looked at (every pixel still
+/// exists twice: at 4K one image of statistics is 232 MB, 265 MB with 2
+/// replicates). So a cancelled pass leaves the tiles it finished with its
+/// samples and the others without: an *unfinished* film, which can be looked at (every pixel still
 /// holds a whole number of samples) but not saved, merged or extended.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
