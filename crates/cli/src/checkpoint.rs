@@ -420,3 +420,109 @@ fn decode_block(path: &Path, layers: &[usize], fill: &mut SlotFill<'_>) -> Resul
         (Ok(()), None) => Ok(()),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    /// A film of 3x2 pixels over `0..2`, and its slots: replicate `r` of
+    /// pixel `i` holds one sample, unless it is the dropped one.
+    fn film(replicates: u32) -> (Film, Vec<PixelStats>) {
+        let slots: Vec<PixelStats> = (0..6 * replicates)
+            .map(|i| {
+                let x = i as f32 * 0.37 + 1.0;
+                let mut s = PixelStats::of_sample(Vec3::new(x, 2.0 * x, x * x));
+                if i == 4 {
+                    s = PixelStats::default();
+                } else {
+                    s.m2 = Vec3::splat(x);
+                }
+                s
+            })
+            .collect();
+        let film = Film::starting_at(3, 2, 0)
+            .append_decoded(0..2, replicates, |fill| {
+                slots
+                    .iter()
+                    .enumerate()
+                    .try_for_each(|(i, s)| fill.put(i, *s))
+            })
+            .unwrap();
+        (film, slots)
+    }
+
+    #[test]
+    fn a_checkpoint_reads_back_the_film_it_saved() {
+        let dir = tempfile::tempdir().unwrap();
+        for k in [1, 2, 3] {
+            let (film, _) = film(k);
+            let path = dir.path().join(format!("k{k}.exr"));
+            save(&path, &film, "scene", "fp").unwrap();
+            assert!(read_film(&path).unwrap().film == film, "{k} replicates");
+        }
+    }
+
+    /// A checkpoint of several replicates saved with `m2` channels, as
+    /// lueur wrote them before it stopped keeping them: still read, its
+    /// counts and means exactly, its `m2` ignored.
+    #[test]
+    fn an_older_checkpoint_of_replicates_with_m2_is_still_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("old.exr");
+        let (film, slots) = film(2);
+        let slots = &slots;
+        let layers: Vec<_> = (0..2)
+            .map(|r| {
+                let channels = SpecificChannels::build()
+                    .with_channel("m2.B")
+                    .with_channel("m2.G")
+                    .with_channel("m2.R")
+                    .with_channel("mean.B")
+                    .with_channel("mean.G")
+                    .with_channel("mean.R")
+                    .with_channel("n")
+                    .with_pixel_fn(move |pos: Vec2<usize>| -> StoredPixel {
+                        let p = slots[(pos.y() * 3 + pos.x()) * 2 + r];
+                        (p.m2.z, p.m2.y, p.m2.x, p.mean.z, p.mean.y, p.mean.x, p.n)
+                    });
+                let attributes = layer_attributes(&(0..2), r, 2, "scene", "fp").unwrap();
+                Layer::new((3, 2), attributes, Encoding::SMALL_LOSSLESS, channels)
+            })
+            .collect();
+        let attributes = ImageAttributes::new(IntegerBounds::from_dimensions((3, 2)));
+        Image::from_layers(attributes, layers)
+            .write()
+            .to_file(&path)
+            .unwrap();
+        let read = read_film(&path).unwrap().film;
+        assert!(read == film);
+        assert!(read.pixels().eq(film.pixels()));
+    }
+
+    /// One replicate needs its `m2`: a checkpoint without it is refused,
+    /// naming the channel, before any pixel is read.
+    #[test]
+    fn a_checkpoint_of_one_replicate_without_m2_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("k1.exr");
+        let (film, _) = film(2);
+        save(&path, &film, "scene", "fp").unwrap();
+        // Relabel the file as one replicate: drop its replicate attributes.
+        let mut meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
+        meta.headers.truncate(1);
+        let header = &mut meta.headers[0];
+        header
+            .own_attributes
+            .other
+            .remove(&Text::from(ATTR_REPLICATE));
+        assert!(
+            check_channels(header, true)
+                .unwrap_err()
+                .to_string()
+                .contains("m2")
+        );
+        assert!(check_channels(header, false).is_ok());
+    }
+}
