@@ -322,6 +322,9 @@ fn decode_into(path: &Path, header: &Header, mut film: Film) -> Result<Film> {
     let mut blocks: Vec<Range<u32>> = header.ranges.iter().map(|(s, _)| s.clone()).collect();
     blocks.sort_by_key(|s| (s.start, s.end));
     blocks.dedup();
+    if header.ranges.len() != blocks.len() * replicates as usize {
+        bail!("{name}: inconsistent replicate layers: a block has a layer twice");
+    }
     for samples in blocks {
         // The layer of each replicate of this block, in replicate order.
         let layers: Vec<usize> = (0..replicates)
