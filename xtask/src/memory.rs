@@ -101,9 +101,16 @@ pub fn run(quick: bool) -> Result<()> {
     let runs = runs(&lueur, w, h, &work)?;
 
     // The scene's sampler (sobol-xor) deals its samples into the default
-    // number of replicates, each a 28-byte statistic per pixel.
+    // number of replicates: per pixel, a count and a mean (16 bytes) per
+    // replicate, and the sum of squared deviations (12 more) only with one
+    // (crates/integrator/src/film/image.rs).
     let replicates = lueur::integrator::DEFAULT_REPLICATES;
-    let film_mb = 28.0 * f64::from(replicates) * f64::from(w) * f64::from(h) / 1e6;
+    let bytes_per_pixel = if replicates == 1 {
+        28.0
+    } else {
+        16.0 * f64::from(replicates)
+    };
+    let film_mb = bytes_per_pixel * f64::from(w) * f64::from(h) / 1e6;
     let mut table = String::new();
     let mut over = Vec::new();
     writeln!(
@@ -133,13 +140,18 @@ pub fn run(quick: bool) -> Result<()> {
              Peak resident memory of `lueur` (release build) on \
              `{SCENE}` at {w}x{h}, each run in a process of its own \
              (`getrusage`, as `/usr/bin/time -v` reports it). One film image \
-             is 28 bytes per pixel per replicate; the scene's sampler deals \
-             its samples into {replicates} (the default): {film_mb:.0} MB. Regenerate with \
+             holds per pixel a count and a mean (16 bytes) per replicate, \
+             and the sum of squared deviations (12 bytes more) only with one \
+             replicate; the scene's sampler deals its samples into \
+             {replicates} (the default): {bytes_per_pixel:.0} bytes per pixel, \
+             {film_mb:.0} MB. Regenerate with \
              `cargo xtask memory` (about 4 minutes on 2 cores); it fails if \
              a render passes {TARGET_MB:.0} MB.\n\n{table}\n\
              The merge holds the merged film, one image per one-bit of its \
-             sample count so far, plus the shard being read: with shards of \
-             one sample, the third shard waits beside `0..2` for the fourth.\n"
+             sample count so far; a shard's blocks are decoded straight into \
+             it (merged into its last block where they are that block's later \
+             half), so with shards of one sample the third waits beside \
+             `0..2` and the fourth merges into it as it is read: two images.\n"
         );
         write_report(quick, "MEMORY.md", &md)?;
     }

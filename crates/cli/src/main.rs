@@ -299,8 +299,9 @@ fn run_merge(args: MergeArgs) -> Result<()> {
         bail!(BadInput("--exposure must be finite".into()));
     }
     // Headers first: every refusal comes before any pixel is read, and the
-    // shards are then loaded one at a time, in order, each merged into the
-    // film and dropped (8 shards of a 4K render never sit in memory at once).
+    // shards are then read one at a time, in order, each block decoded
+    // straight into the film (merged into its last block where it is that
+    // block's later half), so no shard is held beside the film.
     let merge::Shards {
         shards,
         scene_text,
@@ -310,14 +311,8 @@ fn run_merge(args: MergeArgs) -> Result<()> {
     let count = shards.len();
     let mut film: Option<Film> = None;
     for (path, _) in &shards {
-        let shard = checkpoint::read_film(path)
-            .map_err(|e| BadInput(format!("{e:#}")))?
-            .film;
-        let merged = match film.take() {
-            None => shard,
-            Some(f) => Film::merge(vec![f, shard])
-                .map_err(|e| BadInput(format!("cannot merge {}: {e}", path.display())))?,
-        };
+        let merged = checkpoint::merge_into(path, film.take())
+            .map_err(|e| BadInput(format!("cannot merge {}: {e:#}", path.display())))?;
         film = Some(merged);
     }
     let film = film.expect("clap requires one shard");

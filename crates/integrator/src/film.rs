@@ -15,7 +15,8 @@
 //! merging are exact. (Pairwise merging is also more accurate than a
 //! running sum, as pairwise summation is.)
 //!
-//! Memory is the other constraint (a 4K image of statistics is 232 MB):
+//! Memory is the other constraint (a 4K image of statistics is 232 MB, or
+//! 265 MB for 2 replicates: see `film/image.rs`):
 //! a pass is merged in tile by tile as its tiles finish, never held as a
 //! second image, and a film that nobody will extend can be *sealed* so
 //! that its last pass folds the blocks into one image.
@@ -23,12 +24,19 @@
 use std::ops::Range;
 use std::sync::Mutex;
 
-use glam::{UVec2, Vec3};
+use glam::Vec3;
 use smallvec::SmallVec;
 
 use crate::replicates::PixelEstimate;
 
+mod image;
+mod pass;
 mod readout;
+
+use image::Image;
+pub use image::{BlockSlots, SlotFill};
+use pass::join;
+pub(crate) use pass::{PassPlan, PassSink};
 
 /// Mean and variance of one pixel's estimates over a set of samples, per
 /// RGB channel.
@@ -151,6 +159,9 @@ pub enum FilmError {
     /// Films of different image sizes.
     #[error("films of different sizes: {0}x{1} and {2}x{3}")]
     SizeMismatch(u32, u32, u32, u32),
+    /// A saved block that does not give every pixel's statistics.
+    #[error("block {0:?} does not hold every pixel")]
+    Incomplete(Range<u32>),
     /// Sample ranges that leave a gap or overlap.
     #[error("sample ranges do not follow each other: {0:?} then {1:?}")]
     NotContiguous(Range<u32>, Range<u32>),
@@ -200,9 +211,9 @@ struct UnfinishedPass {
 /// row-major, row 0 at the top.
 ///
 /// Passes are merged in tile by tile as the tiles finish (the film never
-/// exists twice: at 4K one image of statistics is 232 MB). So a cancelled
-/// pass leaves the tiles it finished with its samples and the others
-/// without: an *unfinished* film, which can be looked at (every pixel still
+/// exists twice: at 4K one image of statistics is 232 MB, 265 MB with 2
+/// replicates). So a cancelled pass leaves the tiles it finished with its
+/// samples and the others without: an *unfinished* film, which can be looked at (every pixel still
 /// holds a whole number of samples) but not saved, merged or extended.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
@@ -211,145 +222,20 @@ pub struct Film {
     /// First sample index (0 unless the film is a shard).
     start: u32,
     /// Replicates per pixel (see `replicates.rs`): every image holds
-    /// this many [`PixelStats`] per pixel, pixel-major. Taken from the
-    /// first pass while the film is empty.
+    /// this many slots per pixel, pixel-major. Taken from the first pass
+    /// while the film is empty.
     replicates: u32,
     /// The [`dyadic_blocks`] of `start..end`, in order.
     ranges: Vec<Range<u32>>,
     /// Per block, every pixel's statistics over it. Holds more images than
     /// `ranges` while a pass is unfinished (those of its `after`).
-    images: Vec<Vec<PixelStats>>,
+    images: Vec<Image>,
     unfinished: Option<UnfinishedPass>,
     /// The pass that reaches this sample index folds the blocks into one
     /// image (see [`Film::sealed_at`]).
     seal_at: Option<u32>,
     /// Whether it has: `ranges` is then one block, not a dyadic tiling.
     sealed: bool,
-}
-
-/// How a pass's blocks join a film's: computed once from the ranges, then
-/// applied to every pixel with the same merges, in the same order, as
-/// [`Film::append`] applies to whole images.
-#[derive(Clone, Debug)]
-pub(crate) struct PassPlan {
-    samples: Range<u32>,
-    /// The pass's own blocks, as a tile delivers them.
-    pass: Vec<Range<u32>>,
-    /// The film's blocks below this position are not touched.
-    keep: usize,
-    /// Whether the blocks after the pass are folded into one image.
-    seal: bool,
-    before: Vec<Range<u32>>,
-    after: Vec<Range<u32>>,
-}
-
-/// One block joined to a stack of blocks as a binary counter carries:
-/// merged into the top when they are siblings, pushed otherwise, then the
-/// top merged into the one below while they are siblings. Returns the
-/// lowest position written.
-fn join<T: Copy>(
-    stack: &mut SmallVec<[(Range<u32>, T); 8]>,
-    block: (Range<u32>, T),
-    mut merge: impl FnMut(T, T) -> T,
-) -> usize {
-    let mut lowest = stack.len();
-    match stack.last_mut() {
-        Some(top) if siblings(&top.0, &block.0) => {
-            top.0.end = block.0.end;
-            top.1 = merge(top.1, block.1);
-            lowest = stack.len() - 1;
-        }
-        _ => stack.push(block),
-    }
-    while stack.len() >= 2 && siblings(&stack[stack.len() - 2].0, &stack[stack.len() - 1].0) {
-        let (range, later) = stack.pop().expect("two blocks");
-        let below = stack.last_mut().expect("two blocks");
-        below.0.end = range.end;
-        below.1 = merge(below.1, later);
-        lowest = lowest.min(stack.len() - 1);
-    }
-    lowest
-}
-
-impl PassPlan {
-    /// The statistics of one pixel after the pass: `old(j)` is its value in
-    /// the film's block `j` (for `j >= keep`), `pass[m]` its value over the
-    /// pass's block `m`; `write(j, v)` receives the new value of block `j`
-    /// for every `j >= keep`.
-    #[inline]
-    pub(crate) fn apply(
-        &self,
-        old: impl Fn(usize) -> PixelStats,
-        pass: &[PixelStats],
-        mut write: impl FnMut(usize, PixelStats),
-    ) {
-        let mut stack: SmallVec<[(Range<u32>, PixelStats); 8]> = (self.keep..self.before.len())
-            .map(|j| (self.before[j].clone(), old(j)))
-            .collect();
-        for (range, stats) in self.pass.iter().zip(pass) {
-            join(&mut stack, (range.clone(), *stats), PixelStats::merged);
-        }
-        if self.seal {
-            // The fold `Film::pixel_at` would do on the blocks: the same
-            // merges in the same order.
-            write(
-                0,
-                stack
-                    .into_iter()
-                    .fold(PixelStats::default(), |acc, (_, b)| acc.merged(b)),
-            );
-            return;
-        }
-        debug_assert_eq!(stack.len() + self.keep, self.after.len());
-        for (k, (_, stats)) in stack.into_iter().enumerate() {
-            write(self.keep + k, stats);
-        }
-    }
-
-    /// The pass's blocks, in order.
-    pub(crate) fn pass_blocks(&self) -> &[Range<u32>] {
-        &self.pass
-    }
-}
-
-/// Where the tiles of a pass merge their pixels into the film, each under
-/// the lock of its band of rows (a tile's pixels are not contiguous in a
-/// row-major image; a band of `tile` rows is). A tile's commit takes
-/// microseconds against its milliseconds of rendering, so the locks are
-/// not contended.
-pub(crate) struct PassSink<'a> {
-    plan: &'a PassPlan,
-    width: u32,
-    tile: u32,
-    replicates: usize,
-    /// Per band of rows, per block from `plan.keep` on, the band's pixels.
-    bands: Vec<Mutex<Vec<&'a mut [PixelStats]>>>,
-}
-
-impl PassSink<'_> {
-    /// Merges a finished tile in: `blocks[m]` holds the tile's pixels
-    /// (row-major, `size` wide, each its replicates' slots) over the
-    /// pass's block `m`. Each slot joins the film's as one pixel does.
-    pub(crate) fn commit(&self, origin: UVec2, size: UVec2, blocks: &[Vec<PixelStats>]) {
-        let band = origin.y / self.tile;
-        let mut images = self.bands[band as usize]
-            .lock()
-            .unwrap_or_else(|poisoned| poisoned.into_inner());
-        let mut pass: SmallVec<[PixelStats; 8]> = SmallVec::new();
-        let k = self.replicates;
-        for ty in 0..size.y {
-            for (tx, r) in (0..size.x).flat_map(|tx| (0..k).map(move |r| (tx, r))) {
-                let in_tile = (ty * size.x + tx) as usize * k + r;
-                let i = ((origin.y % self.tile + ty) * self.width + origin.x + tx) as usize * k + r;
-                pass.clear();
-                pass.extend(blocks.iter().map(|b| b[in_tile]));
-                let keep = self.plan.keep;
-                let old: SmallVec<[PixelStats; 8]> = images.iter().map(|img| img[i]).collect();
-                self.plan
-                    .apply(|j| old[j - keep], &pass, |j, v| images[j - keep][i] = v);
-            }
-        }
-    }
 }
 
 impl Film {
@@ -413,13 +299,13 @@ impl Film {
     /// in order: the film's full state, what a checkpoint saves. A pixel
     /// is [`Film::replicates`] consecutive slots, one per replicate. Refused
     /// for a film whose last pass was interrupted.
-    pub fn blocks(&self) -> Result<impl Iterator<Item = (Range<u32>, &[PixelStats])>, FilmError> {
+    pub fn blocks(&self) -> Result<impl Iterator<Item = (Range<u32>, BlockSlots<'_>)>, FilmError> {
         self.check_whole()?;
         Ok(self
             .ranges
             .iter()
             .zip(&self.images)
-            .map(|(r, img)| (r.clone(), img.as_slice())))
+            .map(|(r, img)| (r.clone(), BlockSlots(img))))
     }
 
     fn check_whole(&self) -> Result<(), FilmError> {
@@ -449,67 +335,98 @@ impl Film {
         self.sealed
     }
 
-    /// A film from saved blocks (a checkpoint or a shard): each block's
-    /// sample range and its `width * height` pixels, row-major, each pixel
-    /// its `replicates` slots (as [`Film::blocks`] gives them). Refused
-    /// unless the ranges follow each other and every statistic is valid.
-    /// Blocks that are not the maximal dyadic tiling of their range (saved
-    /// by hand, say) are merged as they come: the film is still right, but
-    /// adding to it is no longer bit-identical to rendering at once.
-    pub fn from_blocks(
-        width: u32,
-        height: u32,
-        start: u32,
+    /// Appends one saved block (of a checkpoint or a shard) that follows
+    /// the film's samples, its slots put by `fill` straight into the film:
+    /// into a new image, or merged into the film's last block when the two
+    /// are the halves of one dyadic block (then into nothing new at all),
+    /// after which siblings merge as a binary counter carries, as a render
+    /// does. `replicates` is the saved film's; an empty film takes it.
+    /// Every slot must be put once. The film is consumed, since a failure
+    /// may leave a block half merged. Saved blocks that are not the maximal
+    /// dyadic tiling of their range (saved by hand, say) are merged as they
+    /// come: the film is still right, but adding to it is no longer
+    /// bit-identical to rendering at once.
+    pub fn append_decoded<E: From<FilmError>>(
+        mut self,
+        samples: Range<u32>,
         replicates: u32,
-        blocks: Vec<(Range<u32>, Vec<PixelStats>)>,
-    ) -> Result<Film, FilmError> {
-        let mut film = Film::starting_at(width, height, start);
-        film.replicates = replicates.max(1);
-        for (samples, pixels) in blocks {
-            film.append(samples, pixels)?;
+        fill: impl FnOnce(&mut SlotFill<'_>) -> Result<(), E>,
+    ) -> Result<Film, E> {
+        self.check_follows(&samples)?;
+        let replicates = replicates.max(1);
+        if self.ranges.is_empty() {
+            self.replicates = replicates;
+        } else if self.replicates != replicates {
+            return Err(FilmError::Replicates(self.replicates, replicates).into());
         }
-        Ok(film)
+        let count = self.width as usize * self.height as usize * self.replicates as usize;
+        let later_half = self
+            .ranges
+            .last()
+            .is_some_and(|top| siblings(top, &samples));
+        if !later_half {
+            self.images.push(Image::new(count, self.replicates));
+        }
+        let mut slots = SlotFill {
+            image: self.images.last_mut().expect("an image to fill"),
+            merge: later_half,
+            samples: samples.clone(),
+            written: vec![0; count.div_ceil(64)],
+        };
+        fill(&mut slots)?;
+        if !slots.complete() {
+            return Err(FilmError::Incomplete(samples).into());
+        }
+        match self.ranges.last_mut() {
+            Some(top) if later_half => top.end = samples.end,
+            _ => self.ranges.push(samples),
+        }
+        self.carry();
+        Ok(self)
     }
 
-    /// Appends the statistics of the samples that follow the film's (each
-    /// pixel's, row-major), merging dyadic siblings as a binary counter
-    /// carries (the whole-image form of [`PassPlan::apply`]).
-    fn append(&mut self, samples: Range<u32>, pixels: Vec<PixelStats>) -> Result<(), FilmError> {
+    /// Appends a block of another film that follows this film's samples,
+    /// merging dyadic siblings as a binary counter carries (the
+    /// whole-image form of [`PassPlan::apply`]). The image is moved, not
+    /// copied: merges go into the earlier image, as `PixelStats::merged`
+    /// wants the earlier samples first.
+    fn append(&mut self, samples: Range<u32>, pixels: Image) -> Result<(), FilmError> {
         let count = self.width as usize * self.height as usize * self.replicates as usize;
         if pixels.len() != count {
             return Err(FilmError::PixelCount(pixels.len(), count));
         }
-        let len = samples.end.wrapping_sub(samples.start);
-        let valid = pixels.iter().all(|p| {
-            p.n <= len && p.mean.is_finite() && p.m2.is_finite() && p.m2.min_element() >= 0.0
-        });
-        if !valid {
-            return Err(FilmError::InvalidStats(samples));
-        }
         self.check_follows(&samples)?;
-        let mut stack: SmallVec<[(Range<u32>, usize); 8]> =
-            self.ranges.iter().cloned().zip(0..).collect();
-        // Images are moved, not copied: the merges go into the earlier
-        // image, as `PixelStats::merged` wants the earlier samples first.
-        let mut incoming = Some(pixels);
-        let images = &mut self.images;
-        join(&mut stack, (samples, usize::MAX), |earlier, later| {
-            let later_pixels = if later == usize::MAX {
-                incoming.take().expect("merged once")
-            } else {
-                images.pop().expect("the later image is the last")
-            };
-            for (a, p) in images[earlier].iter_mut().zip(&later_pixels) {
-                *a = a.merged(*p);
+        match self.ranges.last_mut() {
+            Some(top) if siblings(top, &samples) => {
+                self.images
+                    .last_mut()
+                    .expect("one image per block")
+                    .merge_later(&pixels);
+                top.end = samples.end;
             }
-            earlier
-        });
-        if let Some(pixels) = incoming {
-            images.push(pixels);
+            _ => {
+                self.ranges.push(samples);
+                self.images.push(pixels);
+            }
         }
-        self.ranges = stack.into_iter().map(|(r, _)| r).collect();
-        debug_assert_eq!(self.ranges.len(), self.images.len());
+        self.carry();
         Ok(())
+    }
+
+    /// Merges the last block into the one below while they are siblings.
+    fn carry(&mut self) {
+        while let [.., below, top] = self.ranges.as_slice()
+            && siblings(below, top)
+        {
+            let later = self.images.pop().expect("one image per block");
+            self.images
+                .last_mut()
+                .expect("one image per block")
+                .merge_later(&later);
+            let end = self.ranges.pop().expect("two blocks").end;
+            self.ranges.last_mut().expect("two blocks").end = end;
+        }
+        debug_assert_eq!(self.ranges.len(), self.images.len());
     }
 
     fn check_follows(&self, samples: &Range<u32>) -> Result<(), FilmError> {
@@ -548,7 +465,7 @@ impl Film {
         }
         let count = self.width as usize * self.height as usize * self.replicates as usize;
         while self.images.len() < after.len() {
-            self.images.push(vec![PixelStats::default(); count]);
+            self.images.push(Image::new(count, self.replicates));
         }
         Ok(PassPlan {
             samples,
@@ -564,9 +481,9 @@ impl Film {
     pub(crate) fn pass_sink<'a>(&'a mut self, plan: &'a PassPlan, tile: u32) -> PassSink<'a> {
         let band_len = (self.width * tile) as usize * self.replicates as usize;
         let bands_count = self.height.div_ceil(tile) as usize;
-        let mut bands: Vec<Vec<&mut [PixelStats]>> = (0..bands_count).map(|_| Vec::new()).collect();
+        let mut bands: Vec<Vec<image::Band<'_>>> = (0..bands_count).map(|_| Vec::new()).collect();
         for image in self.images[plan.keep..].iter_mut() {
-            for (band, pixels) in bands.iter_mut().zip(image.chunks_mut(band_len)) {
+            for (band, pixels) in bands.iter_mut().zip(image.bands(band_len)) {
                 band.push(pixels);
             }
         }
@@ -622,7 +539,7 @@ impl Film {
         let blocks = self.ranges_of(i).len();
         let slot = |r: usize| {
             (0..blocks).fold(PixelStats::default(), |acc, j| {
-                acc.merged(self.images[j][i * k + r])
+                acc.merged(self.images[j].get(i * k + r))
             })
         };
         if k == 1 {
@@ -694,133 +611,4 @@ impl Film {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::replicates::BlockCounter;
-
-    #[test]
-    fn welford_matches_two_pass() {
-        let xs = [1.0f32, 4.0, 2.5, 10.0, -3.0, 0.25];
-        let mut s = PixelStats::default();
-        for &x in &xs {
-            s.add(Vec3::splat(x));
-        }
-        let mean = xs.iter().sum::<f32>() / xs.len() as f32;
-        let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f32>() / (xs.len() - 1) as f32;
-        assert!((s.mean.x - mean).abs() < 1e-5);
-        assert!((s.sample_variance().x - var).abs() < 1e-4);
-        assert!((s.variance_of_mean().y - var / xs.len() as f32).abs() < 1e-4);
-    }
-
-    #[test]
-    fn pairwise_merge_matches_two_pass() {
-        let xs: Vec<f32> = (0..37)
-            .map(|i| ((i * 7919) % 101) as f32 * 0.37 - 9.0)
-            .collect();
-        let mut counter = BlockCounter::new(1);
-        for (i, &x) in xs.iter().enumerate() {
-            counter.push(i as u32, PixelStats::of_sample(Vec3::splat(x)));
-        }
-        let ranges: Vec<_> = counter.blocks().map(|b| b.0.clone()).collect();
-        assert_eq!(ranges, dyadic_blocks(0..37));
-        let s = counter
-            .blocks()
-            .fold(PixelStats::default(), |a, b| a.merged(b.1[0]));
-        let mean = xs.iter().map(|&x| f64::from(x)).sum::<f64>() / xs.len() as f64;
-        let var = xs
-            .iter()
-            .map(|&x| (f64::from(x) - mean).powi(2))
-            .sum::<f64>()
-            / (xs.len() - 1) as f64;
-        assert_eq!(s.n, 37);
-        assert!((f64::from(s.mean.x) - mean).abs() < 1e-5 * mean.abs().max(1.0));
-        assert!((f64::from(s.sample_variance().x) - var).abs() < 1e-5 * var);
-    }
-
-    #[test]
-    fn dropped_samples_do_not_count() {
-        let mut s = PixelStats::of_sample(Vec3::new(f32::NAN, 0.0, 0.0));
-        assert_eq!(s.n, 0);
-        s = s.merged(PixelStats::of_sample(Vec3::ONE));
-        s = s.merged(PixelStats::of_sample(Vec3::splat(f32::INFINITY)));
-        assert_eq!((s.n, s.mean), (1, Vec3::ONE));
-    }
-
-    #[test]
-    fn one_sample_has_no_variance() {
-        let mut s = PixelStats::default();
-        s.add(Vec3::ONE);
-        assert_eq!(s.variance_of_mean(), Vec3::ZERO);
-    }
-
-    #[test]
-    fn dyadic_blocks_tile_any_range() {
-        assert_eq!(dyadic_blocks(0..100), vec![0..64, 64..96, 96..100]);
-        assert_eq!(dyadic_blocks(64..128), vec![64..128]);
-        assert_eq!(dyadic_blocks(3..13), vec![3..4, 4..8, 8..12, 12..13]);
-        assert_eq!(dyadic_blocks(0..u32::MAX).len(), 32);
-        assert!(dyadic_blocks(5..5).is_empty());
-        for a in 0..70u32 {
-            for b in a..70 {
-                let blocks = dyadic_blocks(a..b);
-                let mut at = a;
-                for r in &blocks {
-                    assert!(is_dyadic(r), "{r:?}");
-                    assert_eq!(r.start, at);
-                    at = r.end;
-                }
-                assert_eq!(at, b);
-                // Maximal: no two neighbours are the halves of one block.
-                assert!(blocks.windows(2).all(|w| !siblings(&w[0], &w[1])));
-            }
-        }
-    }
-
-    fn film_of(samples: Range<u32>, value: impl Fn(u32) -> f32) -> Film {
-        let mut film = Film::starting_at(1, 1, samples.start);
-        for r in dyadic_blocks(samples) {
-            let mut counter = BlockCounter::new(1);
-            for i in r.clone() {
-                counter.push(i, PixelStats::of_sample(Vec3::splat(value(i))));
-            }
-            for (range, stats) in counter.blocks() {
-                film.append(range.clone(), stats.to_vec()).unwrap();
-            }
-        }
-        film
-    }
-
-    #[test]
-    fn any_cut_gives_the_same_bits() {
-        let value = |i: u32| (i as f32 * 0.618_034).fract() * 10.0 + 1e3;
-        let whole = film_of(0..100, value);
-        assert_eq!(whole.blocks().unwrap().count(), 3);
-        for cut in [1, 37, 64, 65, 99] {
-            let parts = vec![film_of(cut..100, value), film_of(0..cut, value)];
-            let merged = Film::merge(parts).unwrap();
-            assert_eq!(merged, whole, "cut at {cut}");
-        }
-        let three = Film::merge(vec![
-            film_of(0..10, value),
-            film_of(10..50, value),
-            film_of(50..100, value),
-        ])
-        .unwrap();
-        assert_eq!(three, whole);
-    }
-
-    #[test]
-    fn merge_refuses_gaps_and_overlaps() {
-        let v = |_| 1.0;
-        let gap = Film::merge(vec![film_of(0..8, v), film_of(9..16, v)]);
-        assert!(matches!(gap, Err(FilmError::NotContiguous(..))));
-        let overlap = Film::merge(vec![film_of(0..8, v), film_of(4..16, v)]);
-        assert!(matches!(overlap, Err(FilmError::NotContiguous(..))));
-        assert_eq!(Film::merge(vec![]), Err(FilmError::Empty));
-        let other_size = Film::starting_at(2, 1, 8);
-        assert!(matches!(
-            Film::merge(vec![film_of(0..8, v), other_size]),
-            Err(FilmError::SizeMismatch(..))
-        ));
-    }
-}
+mod tests;

@@ -59,7 +59,7 @@ mod surface;
 mod trace;
 
 pub use camera::Camera;
-pub use film::{Film, FilmError, PixelStats, dyadic_blocks, is_dyadic};
+pub use film::{BlockSlots, Film, FilmError, PixelStats, SlotFill, dyadic_blocks, is_dyadic};
 pub use geometry::Marching;
 pub use light::{Light, QuadSampling};
 pub use path::RayCounters;

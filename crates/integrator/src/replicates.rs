@@ -17,9 +17,9 @@
 //! each replicate as it can, the replicates of a sequence stay sequences,
 //! and the mapping does not depend on the total spp (a render with a
 //! sequence sampler can still be resumed to more samples). The film keeps,
-//! per pixel and per dyadic block, one [`PixelStats`] per replicate: the
-//! statistics of the block's samples of that replicate, merged slot by
-//! slot, so that every cut into passes, shards and resumes gives the same
+//! per pixel and per dyadic block, one slot per replicate: the count and
+//! mean of the block's samples of that replicate (their spread is not
+//! needed, see `film/image.rs`), merged slot by slot, so that every cut into passes, shards and resumes gives the same
 //! bits, as with one replicate.
 //!
 //! When the spp is not a multiple of `K`, the first `spp % K` replicates
@@ -61,8 +61,7 @@ pub struct PixelEstimate {
     pub n: u32,
     /// Mean of the samples.
     pub mean: Vec3,
-    /// Sum of squared deviations of the samples from the mean.
-    m2: Vec3,
+    sample_variance: Vec3,
     variance_of_mean: Vec3,
     /// Variance of the mean of the channel average `(R + G + B) / 3`.
     variance_of_average: f32,
@@ -117,24 +116,29 @@ impl PixelEstimate {
                 }
             }
         };
+        // With several replicates the film keeps no per-sample spread
+        // (see `film/image.rs`): what one sample is worth is then the one
+        // the error of the mean shows.
+        let sample_variance = match replicates {
+            [one] => one.sample_variance(),
+            _ => variance_of_mean * total.n as f32,
+        };
         PixelEstimate {
             n: total.n,
             mean: total.mean,
-            m2: total.m2,
+            sample_variance,
             variance_of_mean,
             variance_of_average,
         }
     }
 
-    /// Unbiased variance of one sample (zero below two samples): the
-    /// noise of one sample, whatever the replicates.
+    /// Variance of one sample (zero below two samples): with one
+    /// replicate, the unbiased spread of the samples; with several, `n`
+    /// times the variance of the mean, the variance that independent
+    /// samples would need for the error reached (the same thing for
+    /// independent samples, less for well-spread ones).
     pub fn sample_variance(&self) -> Vec3 {
-        PixelStats {
-            n: self.n,
-            mean: self.mean,
-            m2: self.m2,
-        }
-        .sample_variance()
+        self.sample_variance
     }
 
     /// Variance of the pixel mean: the squared standard error of the
