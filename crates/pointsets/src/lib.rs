@@ -384,31 +384,9 @@ pub fn generate(
     dim: usize,
     seed: u64,
 ) -> Result<PointSet, PointSetError> {
-    if dim == 0 {
-        return Err(PointSetError::ZeroDimensions);
-    }
-    if !kind.is_point_set() {
-        return Err(PointSetError::NotAPointSet { kind });
-    }
-    if let Some(max) = kind.max_dimensions() {
-        if kind == PointSetKind::PoissonDisk && dim != 2 {
-            return Err(PointSetError::UnsupportedDimensions {
-                what: "poisson-disk",
-                dim,
-                supported: "2",
-            });
-        }
-        if dim > max {
-            return Err(PointSetError::TooManyDimensions { kind, dim, max });
-        }
-    }
-    if let Some(max) = kind.max_points().filter(|&max| n as u64 > max) {
-        return Err(PointSetError::TooManyPoints { kind, n, max });
-    }
+    check_request(kind, n, dim)?;
     let mut data = vec![0.0; n * dim];
-    // Seeds of the randomizations: one word per (seed, dimension or pair),
-    // hashed so that nearby seeds and dimensions give unrelated scrambles.
-    let dim_seed = |k: usize| hash2(seed, k as u64);
+    let dim_seed = |k: usize| dim_seed(seed, k);
     match kind {
         PointSetKind::Independent => {
             let state = hash2(seed, 0x0069_6e64_6570);
@@ -418,33 +396,7 @@ pub fn generate(
             }
         }
         PointSetKind::Stratified | PointSetKind::Cmj => {
-            for pair in 0..dim.div_ceil(2) {
-                let pair_seed = dim_seed(pair);
-                // The first pair keeps its natural order; the others are
-                // shuffled so that no pair is aligned with another.
-                let order = |i: usize| {
-                    if pair == 0 {
-                        i
-                    } else {
-                        permute(i as u32, n as u32, (pair_seed >> 32) as u32) as usize
-                    }
-                };
-                let two = 2 * pair + 1 < dim;
-                for i in 0..n {
-                    let j = order(i);
-                    let p = if kind == PointSetKind::Cmj {
-                        cmj(j as u32, n as u32, pair_seed as u32)
-                    } else if two {
-                        stratified::jittered_2d(j, n, pair_seed)
-                    } else {
-                        [stratified::jittered_1d(j, n, pair_seed), 0.0]
-                    };
-                    data[i * dim + 2 * pair] = p[0];
-                    if two {
-                        data[i * dim + 2 * pair + 1] = p[1];
-                    }
-                }
-            }
+            stratified_pairs(kind, n, dim, seed, &mut data)
         }
         PointSetKind::LatinHypercube => {
             for k in 0..dim {
@@ -492,26 +444,7 @@ pub fn generate(
                 }
             }
         }
-        PointSetKind::Pmj02 => {
-            for pair in 0..dim.div_ceil(2) {
-                let pair_seed = dim_seed(pair);
-                let sequence = pmj02::pmj02_u32(n, pair_seed);
-                let two = 2 * pair + 1 < dim;
-                for i in 0..n {
-                    // As for the stratified kinds: the first pair in order
-                    // (so prefixes stay nets), the others shuffled.
-                    let j = if pair == 0 {
-                        i
-                    } else {
-                        permute(i as u32, n as u32, (pair_seed >> 32) as u32) as usize
-                    };
-                    data[i * dim + 2 * pair] = u32_to_unit(sequence[j][0]);
-                    if two {
-                        data[i * dim + 2 * pair + 1] = u32_to_unit(sequence[j][1]);
-                    }
-                }
-            }
-        }
+        PointSetKind::Pmj02 => pmj02_pairs(n, dim, seed, &mut data),
         PointSetKind::ZSobol => return Err(PointSetError::NotAPointSet { kind }),
         PointSetKind::PoissonDisk => {
             for (i, p) in poisson::poisson_disk_2d(n, seed).into_iter().enumerate() {
@@ -521,4 +454,93 @@ pub fn generate(
         }
     }
     Ok(PointSet { dim, data })
+}
+
+/// Refuses what `generate` cannot build: no dimension, a kind that is not a
+/// point set, more dimensions or points than the kind has.
+fn check_request(kind: PointSetKind, n: usize, dim: usize) -> Result<(), PointSetError> {
+    if dim == 0 {
+        return Err(PointSetError::ZeroDimensions);
+    }
+    if !kind.is_point_set() {
+        return Err(PointSetError::NotAPointSet { kind });
+    }
+    if let Some(max) = kind.max_dimensions() {
+        if kind == PointSetKind::PoissonDisk && dim != 2 {
+            return Err(PointSetError::UnsupportedDimensions {
+                what: "poisson-disk",
+                dim,
+                supported: "2",
+            });
+        }
+        if dim > max {
+            return Err(PointSetError::TooManyDimensions { kind, dim, max });
+        }
+    }
+    if let Some(max) = kind.max_points().filter(|&max| n as u64 > max) {
+        return Err(PointSetError::TooManyPoints { kind, n, max });
+    }
+    Ok(())
+}
+
+/// The seed of the randomization of dimension (or pair) `k`: one word per
+/// (seed, k), hashed so that nearby seeds and dimensions give unrelated
+/// scrambles.
+fn dim_seed(seed: u64, k: usize) -> u64 {
+    hash2(seed, k as u64)
+}
+
+/// Jittered or CMJ points, pair of dimensions by pair.
+fn stratified_pairs(kind: PointSetKind, n: usize, dim: usize, seed: u64, data: &mut [f64]) {
+    let dim_seed = |k: usize| dim_seed(seed, k);
+    for pair in 0..dim.div_ceil(2) {
+        let pair_seed = dim_seed(pair);
+        // The first pair keeps its natural order; the others are
+        // shuffled so that no pair is aligned with another.
+        let order = |i: usize| {
+            if pair == 0 {
+                i
+            } else {
+                permute(i as u32, n as u32, (pair_seed >> 32) as u32) as usize
+            }
+        };
+        let two = 2 * pair + 1 < dim;
+        for i in 0..n {
+            let j = order(i);
+            let p = if kind == PointSetKind::Cmj {
+                cmj(j as u32, n as u32, pair_seed as u32)
+            } else if two {
+                stratified::jittered_2d(j, n, pair_seed)
+            } else {
+                [stratified::jittered_1d(j, n, pair_seed), 0.0]
+            };
+            data[i * dim + 2 * pair] = p[0];
+            if two {
+                data[i * dim + 2 * pair + 1] = p[1];
+            }
+        }
+    }
+}
+
+/// PMJ02 points, pair of dimensions by pair.
+fn pmj02_pairs(n: usize, dim: usize, seed: u64, data: &mut [f64]) {
+    let dim_seed = |k: usize| dim_seed(seed, k);
+    for pair in 0..dim.div_ceil(2) {
+        let pair_seed = dim_seed(pair);
+        let sequence = pmj02::pmj02_u32(n, pair_seed);
+        let two = 2 * pair + 1 < dim;
+        for i in 0..n {
+            // As for the stratified kinds: the first pair in order
+            // (so prefixes stay nets), the others shuffled.
+            let j = if pair == 0 {
+                i
+            } else {
+                permute(i as u32, n as u32, (pair_seed >> 32) as u32) as usize
+            };
+            data[i * dim + 2 * pair] = u32_to_unit(sequence[j][0]);
+            if two {
+                data[i * dim + 2 * pair + 1] = u32_to_unit(sequence[j][1]);
+            }
+        }
+    }
 }
