@@ -2,25 +2,9 @@
 
 mod common;
 
-use common::exr_pixels;
+use common::{exr_pixels, lueur, scene, stderr};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn lueur(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lueur"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
-
-fn scene(name: &str) -> String {
-    format!("{}/../../scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use std::process::Command;
 
 fn files_in(dir: &Path) -> Vec<PathBuf> {
     std::fs::read_dir(dir)

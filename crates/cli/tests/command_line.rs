@@ -4,25 +4,11 @@
 
 mod common;
 
+use common::{lueur, scene, stderr};
+
 use std::path::Path;
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
-
-fn lueur(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lueur"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
-
-fn scene(name: &str) -> String {
-    format!("{}/../../scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 fn entries(dir: &Path) -> usize {
     std::fs::read_dir(dir).unwrap().count()

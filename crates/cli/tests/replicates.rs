@@ -2,24 +2,12 @@
 //! refused before rendering, and every end of a render says the error it
 //! reached.
 
+mod common;
+
+use common::{lueur, scene, stderr};
+
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn lueur(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lueur"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
-
-fn scene(name: &str) -> String {
-    format!("{}/../../scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use std::process::Output;
 
 fn render(extra: &[&str], dir: &Path) -> Output {
     let cornell = scene("cornell-spheres");

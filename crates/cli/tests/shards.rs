@@ -1,6 +1,10 @@
 //! Renders cut into shards, by hand and by the scripts in `scripts/`, merge
 //! into the bit-identical image of one render.
 
+mod common;
+
+use common::{exr_pixels, stderr};
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -28,10 +32,6 @@ fn lueur(args: &[&str], dir: &Path) -> Output {
         .unwrap()
 }
 
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
 fn render(dir: &Path, extra: &[&str]) {
     let scene = donut();
     let mut args = vec!["render", scene.as_str()];
@@ -43,27 +43,6 @@ fn render(dir: &Path, extra: &[&str]) {
 
 fn read(dir: &Path, name: &str) -> Vec<u8> {
     std::fs::read(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
-}
-
-/// An EXR's pixels, every channel of every layer as bits: what must be
-/// bit-identical between two renders of one image, whose headers differ
-/// (their provenance has the render time).
-fn exr_pixels(path: &std::path::Path) -> Vec<(String, Vec<u32>)> {
-    use exr::prelude::{FlatSamples, read_all_flat_layers_from_file};
-    let image = read_all_flat_layers_from_file(path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
-    image
-        .layer_data
-        .iter()
-        .flat_map(|layer| layer.channel_data.list.iter())
-        .map(|c| {
-            let bits = match &c.sample_data {
-                FlatSamples::F16(v) => v.iter().map(|x| u32::from(x.to_bits())).collect(),
-                FlatSamples::F32(v) => v.iter().map(|x| x.to_bits()).collect(),
-                FlatSamples::U32(v) => v.clone(),
-            };
-            (c.name.to_string(), bits)
-        })
-        .collect()
 }
 
 /// Shards at any cut (not only powers of two), merged in any order, give

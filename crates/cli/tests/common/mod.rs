@@ -1,4 +1,27 @@
-//! Helpers shared by the CLI's test binaries.
+//! Helpers shared by the CLI's test binaries (each uses some of them).
+#![allow(dead_code)]
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Runs the `lueur` binary in `dir`.
+pub fn lueur(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lueur"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+/// The path of a shipped scene.
+pub fn scene(name: &str) -> String {
+    format!("{}/../../scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// What a run printed on standard error.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
 
 /// An EXR's pixels, every channel of every layer as bits: what must be
 /// bit-identical between two renders of one image, whose headers differ
