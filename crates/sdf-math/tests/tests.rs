@@ -41,9 +41,22 @@ mod strategies {
         (unit(), -4f32..4.0).prop_map(|(axis, angle)| Quat::from_axis_angle(axis, angle))
     }
 
-    /// Which primitive, so that each gets its own conformance run.
-    #[derive(Clone, Copy, Debug)]
-    pub enum Kind {
+    /// Declares the primitive kinds and their list together, so that no kind can be left
+    /// out of the conformance runs.
+    macro_rules! kinds {
+        ($($kind:ident),* $(,)?) => {
+            /// Which primitive, so that each gets its own conformance run.
+            #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+            pub enum Kind {
+                $($kind,)*
+            }
+
+            /// Every kind, each once.
+            pub const KINDS: &[Kind] = &[$(Kind::$kind,)*];
+        };
+    }
+
+    kinds!(
         Sphere,
         Box,
         RoundBox,
@@ -52,18 +65,32 @@ mod strategies {
         CappedCylinder,
         Capsule,
         DeathStar,
-    }
+    );
 
-    pub const KINDS: [Kind; 8] = [
-        Kind::Sphere,
-        Kind::Box,
-        Kind::RoundBox,
-        Kind::Plane,
-        Kind::Torus,
-        Kind::CappedCylinder,
-        Kind::Capsule,
-        Kind::DeathStar,
-    ];
+    /// The kind of a primitive node, `None` for combinations and transforms. The match
+    /// has no wildcard: a new `Sdf` variant does not compile until it is given a kind
+    /// here, and with it a conformance run.
+    pub fn kind_of(sdf: &Sdf) -> Option<Kind> {
+        match sdf {
+            Sdf::Sphere { .. } => Some(Kind::Sphere),
+            Sdf::Box { .. } => Some(Kind::Box),
+            Sdf::RoundBox { .. } => Some(Kind::RoundBox),
+            Sdf::Plane { .. } => Some(Kind::Plane),
+            Sdf::Torus { .. } => Some(Kind::Torus),
+            Sdf::CappedCylinder { .. } => Some(Kind::CappedCylinder),
+            Sdf::Capsule { .. } => Some(Kind::Capsule),
+            Sdf::DeathStar { .. } => Some(Kind::DeathStar),
+            Sdf::Union { .. }
+            | Sdf::Intersection { .. }
+            | Sdf::Difference { .. }
+            | Sdf::SmoothUnion { .. }
+            | Sdf::SmoothIntersection { .. }
+            | Sdf::SmoothDifference { .. }
+            | Sdf::Translate { .. }
+            | Sdf::Rotate { .. }
+            | Sdf::Scale { .. } => None,
+        }
+    }
 
     /// Primitives of roughly unit size, including degenerate parameters (a round box
     /// radius past the smallest extent, a spindle torus, an empty Death Star).
@@ -93,7 +120,7 @@ mod strategies {
     }
 
     pub fn unit_primitive() -> BoxedStrategy<Sdf> {
-        prop::strategy::Union::new(KINDS.map(unit_primitive_of)).boxed()
+        prop::strategy::Union::new(KINDS.iter().map(|&k| unit_primitive_of(k)).collect::<Vec<_>>()).boxed()
     }
 
     /// A unit primitive scaled by `size` (by editing its parameters, not with `Scale`).
@@ -143,7 +170,7 @@ mod strategies {
 
     /// Any primitive, as [`primitive_of`].
     pub fn primitive() -> BoxedStrategy<Sdf> {
-        prop::strategy::Union::new(KINDS.map(primitive_of)).boxed()
+        prop::strategy::Union::new(KINDS.iter().map(|&k| primitive_of(k)).collect::<Vec<_>>()).boxed()
     }
 
     pub fn children() -> impl Strategy<Value = Vec<Sdf>> {
@@ -1239,5 +1266,30 @@ mod relaxed {
             relaxed += sphere_trace_relaxed(&sdf, &ray, &p, OVER_RELAXATION).steps() as u64;
         }
         assert!(relaxed < plain, "relaxed {relaxed} >= plain {plain} steps");
+    }
+}
+
+/// The conformance runs cover every primitive: each kind's generators make shapes of that
+/// kind (so no run tests another primitive twice), and the list holds each kind once.
+#[test]
+fn every_primitive_kind_has_its_conformance_run() {
+    use proptest::strategy::ValueTree;
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    for (i, &kind) in KINDS.iter().enumerate() {
+        assert!(!KINDS[..i].contains(&kind), "{kind:?} listed twice");
+        for generator in [unit_primitive_of(kind), primitive_of(kind)] {
+            for _ in 0..8 {
+                let shape = generator.new_tree(&mut runner).unwrap().current();
+                // Through the transforms the generators put around a primitive.
+                let mut node = &shape;
+                while let Sdf::Translate { child, .. }
+                | Sdf::Rotate { child, .. }
+                | Sdf::Scale { child, .. } = node
+                {
+                    node = child;
+                }
+                assert_eq!(kind_of(node), Some(kind), "{shape:?}");
+            }
+        }
     }
 }
