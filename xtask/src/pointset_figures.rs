@@ -45,7 +45,7 @@ const ZSOBOL: RGBColor = RGBColor(31, 119, 180);
 /// unclamped, their energy swamps the spectrum and its comparison rests on
 /// a handful of pixels. The rest of the error is below
 /// it and kept linear, so unbiased (an sRGB error would be biased where the
-/// noise is large, E[srgb(x)] < srgb(E[x]), a low-frequency pattern that
+/// noise is large, `E[srgb(x)] < srgb(E[x])`, a low-frequency pattern that
 /// both samplers share). The summary prints how many pixels it changed.
 const ERROR_CLAMP: f64 = 1.0;
 
