@@ -120,7 +120,13 @@ mod strategies {
     }
 
     pub fn unit_primitive() -> BoxedStrategy<Sdf> {
-        prop::strategy::Union::new(KINDS.iter().map(|&k| unit_primitive_of(k)).collect::<Vec<_>>()).boxed()
+        prop::strategy::Union::new(
+            KINDS
+                .iter()
+                .map(|&k| unit_primitive_of(k))
+                .collect::<Vec<_>>(),
+        )
+        .boxed()
     }
 
     /// A unit primitive scaled by `size` (by editing its parameters, not with `Scale`).
@@ -170,7 +176,8 @@ mod strategies {
 
     /// Any primitive, as [`primitive_of`].
     pub fn primitive() -> BoxedStrategy<Sdf> {
-        prop::strategy::Union::new(KINDS.iter().map(|&k| primitive_of(k)).collect::<Vec<_>>()).boxed()
+        prop::strategy::Union::new(KINDS.iter().map(|&k| primitive_of(k)).collect::<Vec<_>>())
+            .boxed()
     }
 
     pub fn children() -> impl Strategy<Value = Vec<Sdf>> {
