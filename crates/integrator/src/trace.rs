@@ -132,7 +132,7 @@ impl Scene {
         marching: Marching,
         counters: &mut TraceCounters,
     ) -> Option<Hit> {
-        self.intersect_ray(ray, ray.origin, params, marching, counters, false)
+        self.intersect_leaving(ray, ray.origin, params, marching, counters, false)
     }
 
     /// [`Scene::intersect`] for a ray that may start inside a solid: a
@@ -151,7 +151,7 @@ impl Scene {
         marching: Marching,
         counters: &mut TraceCounters,
     ) -> Option<Hit> {
-        self.intersect_ray(ray, ray.origin, params, marching, counters, true)
+        self.intersect_leaving(ray, ray.origin, params, marching, counters, true)
     }
 
     /// [`Scene::intersect`] (or, with `maybe_inside`, [`Scene::intersect_maybe_inside`])
@@ -162,18 +162,6 @@ impl Scene {
     /// estimation and the MIS weights use, however far the origin had to be lifted; light
     /// hits' `t` are measured from `from`.
     pub(crate) fn intersect_leaving(
-        &self,
-        ray: &Ray,
-        from: Vec3,
-        params: &TraceParams,
-        marching: Marching,
-        counters: &mut TraceCounters,
-        maybe_inside: bool,
-    ) -> Option<Hit> {
-        self.intersect_ray(ray, from, params, marching, counters, maybe_inside)
-    }
-
-    fn intersect_ray(
         &self,
         ray: &Ray,
         from: Vec3,
@@ -266,7 +254,7 @@ impl Scene {
                 self.geometry
                     .trace(ray, &TraceParams { t_max, ..*params }, marching);
             counters.record(&outcome);
-            // A shadow ray that gives up is taken as a hit too (see `intersect_ray`).
+            // A shadow ray that gives up is taken as a hit too (see `intersect_leaving`).
             matches!(outcome, TraceOutcome::Miss { .. })
         };
         counters.stop(clock);
