@@ -8,14 +8,15 @@ use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
-use lueur_integrator::{Marching, RenderSettings, Scene, Strategy, TraceCounters, render};
+use lueur_integrator::{PreparedScene, TraceCounters, render};
 use lueur_scene::parse_scene;
+use lueur_scene::{Marching, RenderSettings, Strategy};
 use lueur_sdf_math::{Ray, TraceParams};
 
 const SCENES: [&str; 3] = ["cornell-spheres", "death-star", "donut-mirrors"];
 const MODES: [(Marching, &str); 2] = [(Marching::Naive, "naive"), (Marching::Fast, "fast")];
 
-fn load(name: &str, marching: Marching) -> (Scene, RenderSettings) {
+fn load(name: &str, marching: Marching) -> (PreparedScene, RenderSettings) {
     let file = format!("{}/scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(&file).expect("shipped scenes are readable");
     let parsed = parse_scene(&text, &file).expect("shipped scenes parse");
@@ -23,15 +24,15 @@ fn load(name: &str, marching: Marching) -> (Scene, RenderSettings) {
         marching,
         ..parsed.settings
     };
-    (parsed.scene, settings)
+    (PreparedScene::new(parsed.scene), settings)
 }
 
 /// Camera rays through a 32x32 grid of pixel centres of a 256x256 image.
-fn camera_rays(scene: &Scene) -> Vec<Ray> {
+fn camera_rays(scene: &PreparedScene) -> Vec<Ray> {
     (0..32 * 32)
         .map(|i| {
             let film = Vec2::new((i % 32) as f32 * 8.0 + 4.0, (i / 32) as f32 * 8.0 + 4.0);
-            scene.camera.generate_ray(film, 256, 256)
+            scene.scene().camera.generate_ray(film, 256, 256)
         })
         .collect()
 }
@@ -39,13 +40,13 @@ fn camera_rays(scene: &Scene) -> Vec<Ray> {
 /// Camera-ray parameters as the integrator derives them for a 256x256 render (the
 /// integrator raises the absolute threshold per ray to the rounding at its origin, which
 /// `intersect` does here too).
-fn camera_params(scene: &Scene, settings: &RenderSettings) -> TraceParams {
+fn camera_params(scene: &PreparedScene, settings: &RenderSettings) -> TraceParams {
     TraceParams {
         t_min: 0.0,
         t_max: 100.0 * scene.scale(),
         max_steps: settings.max_steps,
         eps_abs: 0.0,
-        eps_rel: settings.pixel_epsilon * scene.camera.pixel_angle(256),
+        eps_rel: settings.pixel_epsilon * scene.scene().camera.pixel_angle(256),
     }
 }
 

@@ -11,7 +11,8 @@
 //! file.settings.width = 16;
 //! file.settings.height = 16;
 //! file.settings.spp = 4;
-//! let out = lueur::integrator::render(&file.scene, &file.settings, &|_| {}).unwrap();
+//! let scene = lueur::integrator::PreparedScene::new(file.scene);
+//! let out = lueur::integrator::render(&scene, &file.settings, &|_| {}).unwrap();
 //! assert_eq!(out.stats.dropped_samples, 0);
 //! ```
 #![deny(missing_docs)]
@@ -29,8 +30,9 @@ pub use lueur_sampling as sampling;
 /// BSDFs: Lambertian and mirror.
 pub use lueur_materials as materials;
 
-/// Scenes, strategies, the film and the render loop.
-pub use lueur_integrator as integrator;
-
-/// Scene files.
+/// What a scene is (objects, materials, lights, camera, render settings)
+/// and its file format.
 pub use lueur_scene as scene;
+
+/// Tracing, strategies, the film and the render loop.
+pub use lueur_integrator as integrator;

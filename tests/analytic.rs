@@ -7,9 +7,9 @@
 use std::f32::consts::PI;
 
 use glam::Vec3;
-use lueur::integrator::{Camera, Light, QuadSampling, RenderSettings, Strategy};
 use lueur::materials::Material;
 use lueur::sampling::SamplerKind;
+use lueur::scene::{Camera, Light, QuadSampling, RenderSettings, Strategy};
 use lueur::sdf_math::{Quat, Sdf};
 
 use crate::common::{run, scene_of};

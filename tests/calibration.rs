@@ -21,9 +21,10 @@
 //! every seed gives the same image, and no variance describes its error.
 
 use glam::Vec3;
-use lueur::integrator::{Camera, Film, RenderSettings, Scene, Strategy};
+use lueur::integrator::Film;
 use lueur::materials::Material;
 use lueur::sampling::SamplerKind;
+use lueur::scene::{Camera, RenderSettings, Scene, Strategy};
 use lueur::sdf_math::Sdf;
 
 use crate::common::{run, scene_of};
@@ -154,7 +155,7 @@ fn one_replicate_overstates_qmc_error() {
 fn an_error_target_stops_with_the_true_error_near_the_target() {
     use std::sync::atomic::AtomicBool;
 
-    use lueur::integrator::render_pass;
+    use lueur::integrator::{PreparedScene, render_pass};
 
     let scene = scene();
     let truth = reference(&scene);
@@ -165,6 +166,7 @@ fn an_error_target_stops_with_the_true_error_near_the_target() {
         / (3.0 * truth.len() as f64);
     let target = 0.03;
     let never = AtomicBool::new(false);
+    let prepared = PreparedScene::new(scene.clone());
     let ratios = |replicates: Option<u32>| -> Vec<f64> {
         (0..20)
             .map(|seed| {
@@ -172,7 +174,7 @@ fn an_error_target_stops_with_the_true_error_near_the_target() {
                 let mut film = Film::new(8, 8);
                 loop {
                     let until = (film.spp() * 2).max(1);
-                    render_pass(&scene, &s, &mut film, until, &never, &|_| {}).unwrap();
+                    render_pass(&prepared, &s, &mut film, until, &never, &|_| {}).unwrap();
                     if film.relative_error() <= target || until == s.spp {
                         break;
                     }

@@ -1,8 +1,9 @@
 //! Helpers shared by the end-to-end tests.
 
 use glam::Vec3;
-use lueur::integrator::{Camera, Film, Light, Object, RenderOutput, RenderSettings, Scene, render};
+use lueur::integrator::{Film, PreparedScene, RenderOutput, render};
 use lueur::materials::Material;
+use lueur::scene::{Camera, Light, Object, RenderSettings, Scene};
 use lueur::scene::{SceneFile, parse_scene};
 use lueur::sdf_math::Sdf;
 
@@ -13,11 +14,16 @@ pub fn shipped(name: &str) -> SceneFile {
     parse_scene(&text, &path).unwrap()
 }
 
+/// A parsed file's scene, prepared for rendering.
+pub fn prepared(file: &SceneFile) -> PreparedScene {
+    PreparedScene::new(file.scene.clone())
+}
+
 pub const SHIPPED: [&str; 3] = ["cornell-spheres", "death-star", "donut-mirrors"];
 
 /// Renders on the current rayon pool with no progress reporting.
 pub fn run(scene: &Scene, settings: &RenderSettings) -> RenderOutput {
-    let out = render(scene, settings, &|_| {}).unwrap();
+    let out = render(&PreparedScene::new(scene.clone()), settings, &|_| {}).unwrap();
     assert_eq!(out.stats.dropped_samples, 0, "NaN or infinite samples");
     out
 }

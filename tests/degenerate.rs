@@ -6,9 +6,10 @@
 //! renders so that their errors are independent, as the test assumes).
 
 use glam::Vec3;
-use lueur::integrator::{Camera, Light, RenderOutput, RenderSettings, SceneError, Strategy};
+use lueur::integrator::RenderOutput;
 use lueur::materials::Material;
 use lueur::sampling::SamplerKind;
+use lueur::scene::{Camera, Light, RenderSettings, SceneError, Strategy};
 use lueur::scene::{SceneFile, SceneFileError, parse_scene};
 use lueur::sdf_math::Sdf;
 

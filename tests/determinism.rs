@@ -1,4 +1,4 @@
-use lueur::integrator::Strategy;
+use lueur::scene::Strategy;
 
 use crate::common::{SHIPPED, run_with_threads, shipped};
 
@@ -60,8 +60,15 @@ fn passes_add_up_to_the_single_pass_image_bit_for_bit() {
         let mut film = Film::new(settings.width, settings.height);
         let never = AtomicBool::new(false);
         for until in [1, 2, 4, 8] {
-            let pass =
-                render_pass(&file.scene, &settings, &mut film, until, &never, &|_| {}).unwrap();
+            let pass = render_pass(
+                &crate::common::prepared(&file),
+                &settings,
+                &mut film,
+                until,
+                &never,
+                &|_| {},
+            )
+            .unwrap();
             assert!(pass.complete);
             assert_eq!(film.spp(), until);
         }
@@ -99,8 +106,15 @@ fn shards_merge_into_the_single_render_bit_for_bit() {
             let mut until = range.start;
             while until < range.end {
                 until = (until + step).min(range.end);
-                let pass =
-                    render_pass(&file.scene, &settings, &mut film, until, &never, &|_| {}).unwrap();
+                let pass = render_pass(
+                    &crate::common::prepared(&file),
+                    &settings,
+                    &mut film,
+                    until,
+                    &never,
+                    &|_| {},
+                )
+                .unwrap();
                 assert!(pass.complete);
             }
             film
@@ -128,7 +142,7 @@ fn a_pass_cancelled_at_once_changes_nothing() {
     (settings.width, settings.height, settings.spp) = (16, 16, 4);
     let mut film = Film::new(16, 16);
     let first = render_pass(
-        &file.scene,
+        &crate::common::prepared(&file),
         &settings,
         &mut film,
         2,
@@ -139,7 +153,7 @@ fn a_pass_cancelled_at_once_changes_nothing() {
     assert!(first.complete);
     let before = film.clone();
     let cancelled = render_pass(
-        &file.scene,
+        &crate::common::prepared(&file),
         &settings,
         &mut film,
         4,
@@ -151,8 +165,28 @@ fn a_pass_cancelled_at_once_changes_nothing() {
     assert!(film == before && film.spp() == 2 && film.unfinished_pass().is_none());
     // A pass that adds nothing, or overshoots the render's spp, is refused.
     let never = AtomicBool::new(false);
-    assert!(render_pass(&file.scene, &settings, &mut film, 2, &never, &|_| {}).is_err());
-    assert!(render_pass(&file.scene, &settings, &mut film, 5, &never, &|_| {}).is_err());
+    assert!(
+        render_pass(
+            &crate::common::prepared(&file),
+            &settings,
+            &mut film,
+            2,
+            &never,
+            &|_| {}
+        )
+        .is_err()
+    );
+    assert!(
+        render_pass(
+            &crate::common::prepared(&file),
+            &settings,
+            &mut film,
+            5,
+            &never,
+            &|_| {}
+        )
+        .is_err()
+    );
 }
 
 /// A pass cancelled midway keeps the tiles it finished, bit for bit as the
@@ -171,11 +205,27 @@ fn a_pass_cancelled_midway_keeps_its_finished_tiles() {
     let never = AtomicBool::new(false);
     let mut film = Film::new(60, 40);
     for until in [1, 3] {
-        render_pass(&file.scene, &settings, &mut film, until, &never, &|_| {}).unwrap();
+        render_pass(
+            &crate::common::prepared(&file),
+            &settings,
+            &mut film,
+            until,
+            &never,
+            &|_| {},
+        )
+        .unwrap();
     }
     let before = film.clone();
     let mut whole = film.clone();
-    render_pass(&file.scene, &settings, &mut whole, 8, &never, &|_| {}).unwrap();
+    render_pass(
+        &crate::common::prepared(&file),
+        &settings,
+        &mut whole,
+        8,
+        &never,
+        &|_| {},
+    )
+    .unwrap();
 
     let cancel = AtomicBool::new(false);
     let tiles_done = AtomicUsize::new(0);
@@ -185,7 +235,7 @@ fn a_pass_cancelled_midway_keeps_its_finished_tiles() {
         }
     };
     let pass = render_pass(
-        &file.scene,
+        &crate::common::prepared(&file),
         &settings,
         &mut film,
         8,
@@ -228,7 +278,17 @@ fn a_pass_cancelled_midway_keeps_its_finished_tiles() {
 
     assert!(film.blocks().is_err());
     assert!(Film::merge(vec![film.clone()]).is_err());
-    assert!(render_pass(&file.scene, &settings, &mut film, 8, &never, &|_| {}).is_err());
+    assert!(
+        render_pass(
+            &crate::common::prepared(&file),
+            &settings,
+            &mut film,
+            8,
+            &never,
+            &|_| {}
+        )
+        .is_err()
+    );
 }
 
 /// A film sealed at its end folds its blocks into one image on the pass
@@ -248,7 +308,15 @@ fn a_sealed_film_has_the_unsealed_image_bit_for_bit() {
     let never = AtomicBool::new(false);
     let run = |film: &mut Film, passes: &[u32]| {
         for &until in passes {
-            let pass = render_pass(&file.scene, &settings, film, until, &never, &|_| {}).unwrap();
+            let pass = render_pass(
+                &crate::common::prepared(&file),
+                &settings,
+                film,
+                until,
+                &never,
+                &|_| {},
+            )
+            .unwrap();
             assert!(pass.complete);
         }
     };

@@ -16,8 +16,9 @@
 //! has probability ~3e-4 per scene for normal means; a surface skipped or
 //! shaded wrong over a region of a few pixels moves its mean by far more.
 
-use lueur::integrator::{Film, Marching, RenderSettings, Strategy};
+use lueur::integrator::Film;
 use lueur::sampling::SamplerKind;
+use lueur::scene::{Marching, RenderSettings, Strategy};
 
 use crate::common::{SHIPPED, run, shipped};
 

@@ -30,9 +30,9 @@
 //! fails these tests from the floor of half-extent 10 on (+0.3%; +3% at 100, black at 1e4).
 
 use glam::{Vec2, Vec3};
-use lueur::integrator::{Camera, Light, Object, RenderSettings, Scene, Strategy};
 use lueur::materials::Material;
 use lueur::sampling::SamplerKind;
+use lueur::scene::{Camera, Light, Object, RenderSettings, Scene, Strategy};
 use lueur::sdf_math::Sdf;
 
 use crate::common::run;

@@ -2,8 +2,9 @@
 //! compared with a z-test at Z = 4 on their combined standard error
 //! (two-sided p ~ 6e-5 per comparison for normal means).
 
-use lueur::integrator::{Film, RenderSettings, Strategy};
+use lueur::integrator::Film;
 use lueur::sampling::SamplerKind;
+use lueur::scene::{RenderSettings, Strategy};
 
 use crate::common::{SHIPPED, run, shipped};
 

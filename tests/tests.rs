@@ -35,3 +35,7 @@ mod scale_free;
 // Error bars against a converged reference, for every randomized sampler:
 // the replicates' variance is the true error.
 mod calibration;
+
+// Hostile input for the scene parser: random and mutated files never panic
+// or hang, errors name a line and key, and what parses renders.
+mod fuzz;

@@ -7,9 +7,10 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use image::RgbImage;
-use lueur::integrator::{Film, RenderSettings, Strategy};
+use lueur::integrator::Film;
 use lueur::sampling::SamplerKind;
 use lueur::scene::SceneFile;
+use lueur::scene::{RenderSettings, Strategy};
 
 use crate::compose::{color_bar, error_map, grid, stack};
 use crate::pointset_figures::{ErrorSpectrumPlan, PointsPlan, pointsets_figure, zsobol_figure};

@@ -20,7 +20,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use lueur::integrator::{Film, RenderSettings, Scene, render};
+use lueur::integrator::{Film, PreparedScene, render};
+use lueur::scene::{RenderSettings, Scene};
 use lueur::scene::{SceneFile, parse_scene};
 
 #[derive(Parser)]
@@ -157,7 +158,9 @@ pub fn render_with_bar(scene: &Scene, settings: &RenderSettings, label: &str) ->
             .expect("valid template"),
     );
     bar.set_message(label.to_owned());
-    let out = render(scene, settings, &|n| bar.inc(n))?;
+    let out = render(&PreparedScene::new(scene.clone()), settings, &|n| {
+        bar.inc(n)
+    })?;
     bar.finish_and_clear();
     anyhow::ensure!(
         out.stats.dropped_samples == 0,

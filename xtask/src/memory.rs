@@ -104,7 +104,7 @@ pub fn run(quick: bool) -> Result<()> {
     // number of replicates: per pixel, a count and a mean (16 bytes) per
     // replicate, and the sum of squared deviations (12 more) only with one
     // (crates/integrator/src/film/image.rs).
-    let replicates = lueur::integrator::DEFAULT_REPLICATES;
+    let replicates = lueur::scene::DEFAULT_REPLICATES;
     let bytes_per_pixel = if replicates == 1 {
         28.0
     } else {

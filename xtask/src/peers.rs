@@ -26,9 +26,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, Result, bail, ensure};
-use lueur::integrator::{RenderSettings, Strategy};
 use lueur::sampling::SamplerKind;
 use lueur::scene::SceneFile;
+use lueur::scene::{RenderSettings, Strategy};
 
 use crate::reference::{Reference, cache_dir, flatten, render_film};
 use crate::report::{Plans, write_report};

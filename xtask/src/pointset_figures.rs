@@ -8,10 +8,10 @@ use std::path::Path;
 
 use anyhow::Result;
 use image::RgbImage;
-use lueur::integrator::{RenderSettings, Strategy};
 use lueur::pointsets::{PointSetKind, generate, radial_power_spectrum};
 use lueur::sampling::{Sampler, SamplerKind};
 use lueur::scene::SceneFile;
+use lueur::scene::{RenderSettings, Strategy};
 use plotters::style::RGBColor;
 use rayon::prelude::*;
 

@@ -9,9 +9,10 @@ use std::hash::{DefaultHasher, Hash, Hasher};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use lueur::integrator::{Film, RenderSettings, Strategy, render};
+use lueur::integrator::{Film, PreparedScene, render};
 use lueur::sampling::SamplerKind;
 use lueur::scene::SceneFile;
+use lueur::scene::{RenderSettings, Strategy};
 
 use crate::project_root;
 
@@ -52,7 +53,7 @@ pub fn cache_dir() -> Result<PathBuf> {
 
 /// Renders quietly; any NaN or infinite sample is an error here.
 pub fn render_film(file: &SceneFile, settings: &RenderSettings) -> Result<(Film, f64)> {
-    let out = render(&file.scene, settings, &|_| {})?;
+    let out = render(&PreparedScene::new(file.scene.clone()), settings, &|_| {})?;
     anyhow::ensure!(
         out.stats.dropped_samples == 0,
         "{} NaN/Inf samples",

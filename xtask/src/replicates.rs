@@ -17,8 +17,8 @@
 use std::fmt::Write as _;
 
 use anyhow::{Result, ensure};
-use lueur::integrator::{DEFAULT_REPLICATES, RenderSettings};
 use lueur::sampling::SamplerKind;
+use lueur::scene::{DEFAULT_REPLICATES, RenderSettings};
 
 use crate::load_scene;
 use crate::reference::{flatten, reference, render_film};

@@ -14,9 +14,9 @@
 use std::fmt::Write as _;
 
 use anyhow::{Context, Result, bail};
-use lueur::integrator::{RenderSettings, Strategy};
 use lueur::pointsets::least_squares_slope;
 use lueur::sampling::SamplerKind;
+use lueur::scene::{RenderSettings, Strategy};
 
 use crate::load_scene;
 use crate::reference::{cache_dir, flatten, reference, render_film, squared_error};

@@ -8,12 +8,12 @@
 use std::fmt::Write as _;
 
 use anyhow::{Context, Result};
-use lueur::integrator::{RenderSettings, Strategy};
 use lueur::sampling::SamplerKind;
 use lueur::scene::parse_scene;
+use lueur::scene::{RenderSettings, Strategy};
 
 use crate::{docs_dir, load_scene, render_with_bar};
-use lueur::integrator::{RenderStats, render};
+use lueur::integrator::{PreparedScene, RenderStats, render};
 
 /// The floor's albedo, the lights' radiance, and where they are (issue 14's scene).
 const ALBEDO: f64 = 0.5;
@@ -356,12 +356,12 @@ fn give_ups(out: &mut String, quick: bool) -> Result<()> {
             sampler: SamplerKind::Independent,
             ..file.settings.clone()
         };
-        let capped = render(&file.scene, &settings, &|_| {})?;
+        let capped = render(&PreparedScene::new(file.scene.clone()), &settings, &|_| {})?;
         let generous = RenderSettings {
             max_steps: settings.max_steps * 64,
             ..settings.clone()
         };
-        let reference = render(&file.scene, &generous, &|_| {})?;
+        let reference = render(&PreparedScene::new(file.scene.clone()), &generous, &|_| {})?;
         let share = |stats: &RenderStats| {
             let b = &stats.rays.bounce;
             let s = &stats.rays.shadow;

@@ -20,9 +20,10 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::Result;
-use lueur::integrator::{RenderOutput, RenderSettings, Strategy, render};
+use lueur::integrator::{PreparedScene, RenderOutput, render};
 use lueur::sampling::SamplerKind;
 use lueur::scene::SceneFile;
+use lueur::scene::{RenderSettings, Strategy};
 use plotters::prelude::*;
 
 use crate::load_scene;
@@ -399,7 +400,7 @@ fn settings(
 }
 
 fn render_quiet(file: &SceneFile, settings: &RenderSettings) -> Result<RenderOutput> {
-    let out = render(&file.scene, settings, &|_| {})?;
+    let out = render(&PreparedScene::new(file.scene.clone()), settings, &|_| {})?;
     anyhow::ensure!(
         out.stats.dropped_samples == 0,
         "{} NaN/Inf samples",

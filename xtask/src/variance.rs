@@ -31,9 +31,9 @@
 use std::fmt::Write as _;
 
 use anyhow::{Context, Result, bail};
-use lueur::integrator::{RenderSettings, Strategy};
 use lueur::sampling::SamplerKind;
 use lueur::scene::SceneFile;
+use lueur::scene::{RenderSettings, Strategy};
 
 use crate::load_scene;
 use crate::reference::{Reference, cache_dir, flatten, reference, render_film};

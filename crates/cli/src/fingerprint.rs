@@ -6,7 +6,8 @@
 //! `lueur.settings` attribute); the scene overrides (`--set`) come last,
 //! as a TOML array of strings, since they may hold spaces.
 
-use lueur_integrator::{Marching, PixelBounds, RenderSettings};
+use lueur_integrator::PixelBounds;
+use lueur_scene::{Marching, RenderSettings};
 
 /// The settings of a render, as named text fields in a fixed order.
 #[derive(Clone, Debug, PartialEq)]

@@ -2,8 +2,8 @@
 //! samplers, one line each, as a pbrt or Mitsuba user looks for them.
 //! The matches are exhaustive, so a new kind cannot be left out.
 
-use lueur_integrator::Strategy;
 use lueur_sampling::SamplerKind;
+use lueur_scene::Strategy;
 
 fn strategy_line(s: Strategy) -> &'static str {
     match s {

@@ -29,9 +29,10 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use lueur_integrator::{Film, Strategy};
+use lueur_integrator::Film;
 use lueur_sampling::SamplerKind;
 use lueur_scene::SceneFileError;
+use lueur_scene::Strategy;
 
 use interrupt::Interrupted;
 

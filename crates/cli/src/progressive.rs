@@ -10,8 +10,9 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
 use lueur_integrator::{
-    Film, PixelBounds, RenderOutput, RenderSettings, RenderStats, Scene, render_pass_in,
+    Film, PixelBounds, PreparedScene, RenderOutput, RenderStats, render_pass_in,
 };
+use lueur_scene::RenderSettings;
 
 /// Set by SIGINT, SIGTERM or SIGHUP: the current pass stops after the
 /// tiles it finished.
@@ -73,7 +74,7 @@ pub enum Stop {
 /// pass (to checkpoint it).
 #[allow(clippy::too_many_arguments)]
 pub fn render(
-    scene: &Scene,
+    scene: &PreparedScene,
     settings: &RenderSettings,
     bounds: PixelBounds,
     mut film: Film,

@@ -6,7 +6,7 @@
 
 use std::ops::Range;
 
-use lueur_integrator::RenderSettings;
+use lueur_scene::RenderSettings;
 
 /// Key-value pairs, keys prefixed `lueur.`, in a fixed order.
 #[derive(Clone, Debug, Default)]

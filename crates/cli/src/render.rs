@@ -8,8 +8,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use lueur_integrator::{Film, Marching, PixelBounds, RenderOutput, RenderSettings, Scene};
+use lueur_integrator::{Film, PixelBounds, PreparedScene, RenderOutput};
 use lueur_scene::parse_scene_with;
+use lueur_scene::{Marching, RenderSettings};
 
 use crate::fingerprint::Fingerprint;
 use crate::interrupt::Interrupted;
@@ -25,7 +26,7 @@ struct Job {
     /// The scene file's name and text (for provenance and checkpoints).
     file: String,
     text: String,
-    scene: Scene,
+    scene: PreparedScene,
     settings: RenderSettings,
     /// The sample indices to render (a shard's, or `0..spp`).
     range: Range<u32>,
@@ -91,7 +92,7 @@ fn prepare(args: &mut RenderArgs) -> Result<(Job, Film)> {
     let job = Job {
         file,
         text,
-        scene: parsed.scene,
+        scene: PreparedScene::new(parsed.scene),
         settings,
         range,
         out,
@@ -328,7 +329,7 @@ fn apply_flags(mut s: RenderSettings, a: &RenderArgs) -> Result<RenderSettings> 
         bail!(BadInput("--exposure must be finite".into()));
     }
     s.validate().map_err(|e| match e {
-        lueur_integrator::RenderError::Replicates(why) => match a.replicates {
+        lueur_scene::RenderError::Replicates(why) => match a.replicates {
             Some(_) => BadInput(format!("--replicates: {why}")),
             None => BadInput(format!(
                 "render.replicates of {}: {why} (override it with --replicates)",

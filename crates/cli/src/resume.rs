@@ -44,7 +44,7 @@ pub fn restore(path: &Path, args: &mut RenderArgs) -> Result<Resumed, BadInput> 
     }
     restore!(width, "width", |v: &str| v.parse().ok());
     restore!(height, "height", |v: &str| v.parse().ok());
-    restore!(strategy, "strategy", lueur_integrator::Strategy::from_name);
+    restore!(strategy, "strategy", lueur_scene::Strategy::from_name);
     restore!(sampler, "sampler", SamplerKind::from_name);
     restore!(seed, "seed", |v: &str| v.parse().ok());
     restore!(max_depth, "max_depth", |v: &str| v.parse().ok());

@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-use lueur_integrator::{RenderOutput, RenderSettings};
+use lueur_integrator::RenderOutput;
+use lueur_scene::RenderSettings;
 
 use crate::RenderArgs;
 use crate::progressive::{Limits, Stop};

@@ -12,28 +12,7 @@ use lueur_sdf_math::{
 };
 use smallvec::SmallVec;
 
-use crate::scene::Object;
-
-/// How rays are marched through the objects.
-///
-/// Both modes find the same surfaces (tests hold them to it); `Naive` is kept as the
-/// reference every speed-up is measured against, in the same run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Marching {
-    /// Plain Hart sphere tracing on the plain union of the objects: every step evaluates
-    /// every object; normals by central differences.
-    Naive,
-    /// Each ray first clipped against every object's bound (a box, or a half-space for
-    /// planes): objects whose bound the ray never comes within the hit threshold of are left
-    /// out of its march altogether, and the march runs only over the part of the ray some
-    /// bound covers. Then over-relaxed sphere tracing (Keinert et al. 2014) on the union of
-    /// what is left, where an object whose box is farther than the nearest object found so
-    /// far costs one distance to a box, not its own evaluation. The object hit is the one
-    /// the last step found nearest (no second pass over the scene); normals by the
-    /// tetrahedron (4 evaluations, not 6).
-    #[default]
-    Fast,
-}
+use lueur_scene::{Marching, Object};
 
 /// The union of the objects, as a field the tracer marches.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,13 +1,17 @@
-//! Monte Carlo estimators of the rendering equation over SDF scenes: the
-//! scene model, the strategies that choose directions, the film and the
+//! Monte Carlo estimators of the rendering equation over SDF scenes:
+//! tracing, the strategies that choose directions, the film and the
 //! parallel render loop of lueur.
 //!
-//! The primary entry point is [`render`], which takes a [`Scene`] and
-//! [`RenderSettings`] and returns a [`Film`] of per-pixel means *and
+//! The primary entry point is [`render`], which takes a [`PreparedScene`]
+//! (a `lueur_scene::Scene` with its acceleration) and the scene's
+//! `RenderSettings` and returns a [`Film`] of per-pixel means *and
 //! variances* with [`RenderStats`]: lueur exists to compare sampling
 //! choices, so every render carries its own error estimate.
 //!
-//! The design decision that shapes the crate: a [`Strategy`] is one function
+//! What a scene is (objects, materials, lights, camera, settings) is not
+//! this crate's: it lives in `lueur-scene`, which this crate depends on.
+//!
+//! The design decision that shapes the crate: a `Strategy` is one function
 //! from a vertex and its random numbers to a named scatter (`strategy.rs`),
 //! so the five ways of choosing a direction share everything else (tracing,
 //! mirrors, Russian roulette, directional lights) and differ only where the
@@ -24,7 +28,8 @@
 //!
 //! ```
 //! use glam::Vec3;
-//! use lueur_integrator::{render, Camera, Light, Object, RenderSettings, Scene, Strategy};
+//! use lueur_integrator::{render, PreparedScene};
+//! use lueur_scene::{Camera, Light, Object, RenderSettings, Scene, Strategy};
 //! use lueur_materials::Material;
 //! use lueur_sdf_math::Sdf;
 //!
@@ -39,16 +44,14 @@
 //! )
 //! .unwrap();
 //! let settings = RenderSettings { width: 8, height: 8, spp: 64, strategy: Strategy::Mis, ..Default::default() };
-//! let out = render(&scene, &settings, &|_| {}).unwrap();
+//! let out = render(&PreparedScene::new(scene), &settings, &|_| {}).unwrap();
 //! let (mean, stderr) = out.film.image_mean();
 //! assert!((mean - 1.0).abs() < 5.0 * stderr + 1e-3);
 //! ```
 #![deny(missing_docs)]
 
-mod camera;
 mod film;
 mod geometry;
-mod light;
 mod light_sampler;
 mod path;
 mod render;
@@ -58,62 +61,11 @@ mod strategy;
 mod surface;
 mod trace;
 
-pub use camera::Camera;
 pub use film::{BlockSlots, Film, FilmError, PixelStats, SlotFill, dyadic_blocks, is_dyadic};
-pub use geometry::Marching;
-pub use light::{Light, QuadSampling};
 pub use path::RayCounters;
 pub use render::{
-    Pass, PixelBounds, RenderOutput, RenderSettings, RenderStats, render, render_pass,
-    render_pass_in,
+    Pass, PixelBounds, RenderOutput, RenderStats, render, render_pass, render_pass_in,
 };
-pub use replicates::{DEFAULT_REPLICATES, PixelEstimate, default_replicates};
-pub use scene::{Object, Scene};
-pub use strategy::Strategy;
+pub use replicates::PixelEstimate;
+pub use scene::PreparedScene;
 pub use trace::{Hit, STEP_BUCKETS, TIMED_EVERY, TraceCounters};
-
-/// A scene that cannot be rendered as given.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SceneError {
-    /// The camera is degenerate.
-    #[error("invalid camera: {0}")]
-    Camera(String),
-    /// An object names a material that does not exist.
-    #[error("object {object} uses material {material}, which does not exist")]
-    MissingMaterial {
-        /// Index of the object.
-        object: usize,
-        /// The missing material index.
-        material: usize,
-    },
-    /// A light has a non-positive size, a non-finite position or a negative
-    /// radiance.
-    #[error("light {0} is degenerate (zero size, non-finite, or negative radiance)")]
-    InvalidLight(usize),
-    /// The sky's radiance is negative or not finite.
-    #[error("the sky's radiance must be finite and non-negative")]
-    InvalidSky,
-}
-
-/// Settings a render cannot proceed with.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum RenderError {
-    /// Zero width or height.
-    #[error("the image is empty ({width}x{height})")]
-    EmptyImage {
-        /// Requested width.
-        width: u32,
-        /// Requested height.
-        height: u32,
-    },
-    /// Zero samples per pixel.
-    #[error("spp must be at least 1")]
-    NoSamples,
-    /// Another setting out of its range.
-    #[error("{0}")]
-    InvalidSetting(&'static str),
-    /// Replicates that are zero, more than the spp, or asked of a sampler
-    /// without randomization.
-    #[error("replicates: {0}")]
-    Replicates(String),
-}

@@ -8,7 +8,7 @@ use lueur_sampling::{
     DiscreteDistribution, Frame, cosine_hemisphere_pdf, sample_cosine_hemisphere,
 };
 
-use crate::light::{EmitterSample, Light, QuadSampling};
+use lueur_scene::{EmitterSample, Light, QuadSampling};
 
 /// An emitter that light sampling can choose.
 #[derive(Clone, Copy, Debug, PartialEq)]

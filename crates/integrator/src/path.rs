@@ -10,7 +10,9 @@ use lueur_sdf_math::Ray;
 
 use crate::strategy::{self, EmissionWeight, Lighting, Scatter, Vertex, VertexSample};
 use crate::surface::{March, SurfaceHit, SurfacePoint};
-use crate::{Hit, RenderSettings, Scene, Strategy, TraceCounters};
+use lueur_scene::{RenderSettings, Strategy};
+
+use crate::{Hit, PreparedScene, TraceCounters};
 
 /// Counters per kind of ray.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -62,7 +64,7 @@ impl Previous {
 
 /// What one path estimate needs besides its random numbers.
 pub(crate) struct Estimator<'a> {
-    pub scene: &'a Scene,
+    pub scene: &'a PreparedScene,
     pub settings: &'a RenderSettings,
     pub march: March,
 }
@@ -119,7 +121,7 @@ pub(crate) fn radiance(
         let vertex = Vertex {
             at: surface,
             wo: -ray.dir,
-            material: scene.materials[scene.objects[on_surface.object].material],
+            material: scene.scene().materials[scene.scene().objects[on_surface.object].material],
         };
         let u = VertexSample::draw(sampler, id.pixel, id.index, depth);
 
@@ -171,7 +173,7 @@ fn emission_found(
 ) -> Vec3 {
     let emitters = &lighting.emitters;
     match hit {
-        None => match lighting.scene.sky {
+        None => match lighting.scene.scene().sky {
             Some(sky) => {
                 let w = previous
                     .emission

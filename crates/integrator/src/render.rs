@@ -5,176 +5,21 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::UVec2;
-use lueur_sampling::{Sampler, SamplerKind};
+use lueur_sampling::Sampler;
 use rayon::prelude::*;
 
 use crate::film::{Film, PixelStats};
 use crate::path::{Estimator, RayCounters, SampleId, radiance};
-use crate::replicates::{BlockCounter, default_replicates};
+use crate::replicates::BlockCounter;
 use crate::strategy::CAMERA_DIMS;
 use crate::surface::March;
-use crate::{Marching, QuadSampling, RenderError, Scene, Strategy};
+use lueur_scene::{RenderError, RenderSettings};
+
+use crate::PreparedScene;
 
 /// Side of the square tiles the image is cut into. Small enough that both
 /// cores stay busy to the end, large enough that scheduling is negligible.
 const TILE: u32 = 16;
-
-/// Largest image side accepted.
-pub const MAX_IMAGE_SIDE: u32 = 65_536;
-/// Largest number of pixels accepted (the film holds 28 bytes per pixel).
-pub const MAX_PIXELS: u64 = 1 << 28;
-/// Largest spp accepted: beyond 2^24 a pixel's sample count would no longer
-/// be exact in the f32 arithmetic of its running mean.
-pub const MAX_SPP: u32 = 1 << 24;
-
-/// Everything that decides an image besides the scene.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RenderSettings {
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Samples per pixel.
-    pub spp: u32,
-    /// How directions are chosen.
-    pub strategy: Strategy,
-    /// Which point set feeds the estimator.
-    pub sampler: SamplerKind,
-    /// Independent randomizations the samples are dealt into, whose spread
-    /// is the error bar of each pixel (see `replicates.rs`); `None`
-    /// for the sampler's default ([`default_replicates`]).
-    pub replicates: Option<u32>,
-    /// Maximum number of scattering events (0: emitters seen directly).
-    pub max_depth: u32,
-    /// Scattering events after which Russian roulette may end a path (on
-    /// the throughput's largest component; unbiased, it trades noise for
-    /// time). At `max_depth` or above it never plays.
-    pub roulette_depth: u32,
-    /// Seed of every random number of the render.
-    pub seed: u64,
-    /// Step cap of the sphere tracer.
-    pub max_steps: u32,
-    /// Camera rays hit when closer than this many pixel footprints.
-    pub pixel_epsilon: f32,
-    /// Secondary rays hit when closer than this fraction of the distance
-    /// travelled.
-    pub epsilon_rel: f32,
-    /// How rays are marched through the objects (both modes find the same
-    /// surfaces; `Naive` is the reference of the speed-ups).
-    pub marching: Marching,
-    /// How quad lights are sampled toward a shading point.
-    pub quad_sampling: QuadSampling,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        RenderSettings {
-            width: 256,
-            height: 256,
-            spp: 64,
-            strategy: Strategy::default(),
-            sampler: SamplerKind::default(),
-            replicates: None,
-            max_depth: 8,
-            roulette_depth: 3,
-            seed: 0,
-            max_steps: 256,
-            // A sixteenth of a pixel: a ray that passes this close to a
-            // surface is a hit, so silhouettes grow by this much. At a
-            // quarter pixel they grew visibly against Mitsuba's exact
-            // intersections (24 of 3072 8x8-pixel region-channels beyond
-            // 4 sigma at 1024 spp, all on silhouettes and grazing corners;
-            // none at a sixteenth: docs/PEERS.md), for no measurable time.
-            pixel_epsilon: 0.0625,
-            epsilon_rel: 1e-4,
-            marching: Marching::default(),
-            quad_sampling: QuadSampling::default(),
-        }
-    }
-}
-
-impl RenderSettings {
-    /// Checks what a render cannot proceed without.
-    pub fn validate(&self) -> Result<(), RenderError> {
-        if self.width == 0 || self.height == 0 {
-            return Err(RenderError::EmptyImage {
-                width: self.width,
-                height: self.height,
-            });
-        }
-        if self.spp == 0 {
-            return Err(RenderError::NoSamples);
-        }
-        // The same bounds as scene files, so flags cannot go around them;
-        // and a film beyond 2^28 pixels (28 bytes each: 7.5 GB) is refused
-        // here rather than failing to allocate halfway.
-        if self.width > MAX_IMAGE_SIDE || self.height > MAX_IMAGE_SIDE {
-            return Err(RenderError::InvalidSetting(
-                "width and height must be at most 65536",
-            ));
-        }
-        if u64::from(self.width) * u64::from(self.height) > MAX_PIXELS {
-            return Err(RenderError::InvalidSetting(
-                "the image has more than 2^28 pixels (its film would take over 7.5 GB)",
-            ));
-        }
-        if self.spp > MAX_SPP {
-            return Err(RenderError::InvalidSetting("spp must be at most 2^24"));
-        }
-        if let Some(k) = self.replicates {
-            self.validate_replicates(k)?;
-        }
-        if self.max_steps == 0 {
-            return Err(RenderError::InvalidSetting("max_steps must be at least 1"));
-        }
-        for (v, what) in [
-            (
-                self.pixel_epsilon,
-                "pixel_epsilon must be positive and finite",
-            ),
-            (self.epsilon_rel, "epsilon_rel must be positive and finite"),
-        ] {
-            if !(v > 0.0 && v.is_finite()) {
-                return Err(RenderError::InvalidSetting(what));
-            }
-        }
-        Ok(())
-    }
-}
-
-impl RenderSettings {
-    /// The replicates the render deals its samples into: the settings' or
-    /// the sampler's default.
-    pub fn replicate_count(&self) -> u32 {
-        self.replicates
-            .unwrap_or_else(|| default_replicates(self.sampler, self.spp))
-    }
-
-    fn validate_replicates(&self, k: u32) -> Result<(), RenderError> {
-        if k == 0 {
-            return Err(RenderError::Replicates("must be at least 1, got 0".into()));
-        }
-        if k > self.spp {
-            return Err(RenderError::Replicates(format!(
-                "{k} replicates need at least {k} spp, got {}",
-                self.spp
-            )));
-        }
-        if k > 1 && !self.sampler.is_randomized() {
-            return Err(RenderError::Replicates(format!(
-                "the {} sampler is not randomized: it has no independent replicates \
-                 (use 1, or a randomized sampler such as {}-owen)",
-                self.sampler,
-                if self.sampler == SamplerKind::Halton {
-                    "halton"
-                } else {
-                    "sobol"
-                }
-            )));
-        }
-        Ok(())
-    }
-}
 
 /// What a render measured about itself.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -225,7 +70,7 @@ pub struct RenderOutput {
 /// dimension, seed), and each pixel merges its samples in a fixed tree (see
 /// `film.rs`).
 pub fn render(
-    scene: &Scene,
+    scene: &PreparedScene,
     settings: &RenderSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<RenderOutput, RenderError> {
@@ -271,7 +116,7 @@ pub struct Pass {
 /// [unfinished](Film::unfinished_pass) and can be written out but not
 /// extended), or is left exactly as it was if there were none.
 pub fn render_pass(
-    scene: &Scene,
+    scene: &PreparedScene,
     settings: &RenderSettings,
     film: &mut Film,
     until: u32,
@@ -323,7 +168,7 @@ impl PixelBounds {
 /// of the whole image's film, since the sampler and the camera see the
 /// whole image's pixel coordinates and resolution.
 pub fn render_pass_in(
-    scene: &Scene,
+    scene: &PreparedScene,
     settings: &RenderSettings,
     bounds: PixelBounds,
     film: &mut Film,
@@ -482,7 +327,11 @@ fn render_tile(
                 let jitter = sampler.next_2d();
                 debug_assert_eq!(CAMERA_DIMS, 2);
                 let film_point = glam::Vec2::new(x as f32, y as f32) + jitter;
-                let ray = estimator.scene.camera.generate_ray(film_point, w, h);
+                let ray = estimator
+                    .scene
+                    .scene()
+                    .camera
+                    .generate_ray(film_point, w, h);
                 let l = radiance(estimator, ray, &mut sampler, id, &mut counters);
                 if !l.is_finite() {
                     dropped += 1;

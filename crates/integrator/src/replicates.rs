@@ -30,28 +30,8 @@
 use std::ops::Range;
 
 use glam::Vec3;
-use lueur_sampling::SamplerKind;
 
 use crate::film::{PixelStats, siblings};
-
-/// Replicates of a randomized sampler when the settings do not say: the
-/// smallest count whose error bars are calibrated, as measured in
-/// `cargo xtask replicates` (docs/REPLICATES.md). Each further replicate
-/// costs stratification (a smaller point set each) and film memory.
-pub const DEFAULT_REPLICATES: u32 = 2;
-
-/// The replicates a render of `spp` samples with `sampler` uses by
-/// default: one for the independent sampler, whose per-sample variance is
-/// already valid (and less noisy than a spread of replicates), and for the
-/// plain sequences, which have no randomization to replicate; otherwise
-/// [`DEFAULT_REPLICATES`], at most `spp`.
-pub fn default_replicates(sampler: SamplerKind, spp: u32) -> u32 {
-    if sampler == SamplerKind::Independent || !sampler.is_randomized() {
-        1
-    } else {
-        DEFAULT_REPLICATES.min(spp.max(1))
-    }
-}
 
 /// A pixel's estimate over all its samples: the mean and the error of the
 /// mean, from its replicates' statistics.

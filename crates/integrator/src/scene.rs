@@ -1,118 +1,50 @@
-//! The scene as the integrator sees it: SDF objects with materials, lights,
-//! an optional sky and the camera, validated once. Its queries live beside
-//! it: acceleration in `geometry.rs`, tracing in `trace.rs`, the lights in
-//! `light.rs` and the choice among them in `light_sampler.rs`.
+//! The scene as the integrator sees it: the scene model with what tracing
+//! and light sampling derive from it once. The queries live beside it:
+//! acceleration in `geometry.rs`, tracing in `trace.rs` and the choice
+//! among the lights in `light_sampler.rs`.
 
 use glam::Vec3;
-use lueur_materials::Material;
-use lueur_sdf_math::{PreparedSdf, Ray, Sdf};
+use lueur_scene::{Marching, QuadSampling, Scene};
+use lueur_sdf_math::{PreparedSdf, Ray};
 
 use crate::geometry::Geometry;
-use crate::light::valid_rgb;
 use crate::light_sampler::{Emitters, LightSampler};
-use crate::{Camera, Light, Marching, QuadSampling, SceneError};
 
-/// One piece of geometry and what it is made of.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Object {
-    /// Its shape.
-    pub sdf: Sdf,
-    /// Index into [`Scene::materials`].
-    pub material: usize,
-}
-
-/// A complete scene, ready to render.
+/// A [`Scene`] prepared for rendering: its objects' fields folded for fast
+/// evaluation and bounded for culling, and the choice among its emitters.
+/// Preparing costs a pass over the objects; a progressive render prepares
+/// once and renders every pass from it.
 #[derive(Clone, Debug)]
-pub struct Scene {
-    /// Geometry.
-    pub objects: Vec<Object>,
-    /// Materials referenced by the objects.
-    pub materials: Vec<Material>,
-    /// Light sources.
-    pub lights: Vec<Light>,
-    /// Constant radiance arriving from every direction a ray escapes to.
-    pub sky: Option<Vec3>,
-    /// The viewpoint.
-    pub camera: Camera,
-    // Derived at construction.
+pub struct PreparedScene {
+    scene: Scene,
     pub(crate) geometry: Geometry,
     /// The choice among the lights and the sky that light sampling aims at.
     light_sampler: LightSampler,
-    size: f32,
+    scale: f32,
 }
 
-impl Scene {
-    /// Assembles and validates a scene.
-    pub fn new(
-        objects: Vec<Object>,
-        materials: Vec<Material>,
-        lights: Vec<Light>,
-        sky: Option<Vec3>,
-        camera: Camera,
-    ) -> Result<Scene, SceneError> {
-        for (i, o) in objects.iter().enumerate() {
-            if o.material >= materials.len() {
-                return Err(SceneError::MissingMaterial {
-                    object: i,
-                    material: o.material,
-                });
-            }
-        }
-        for (i, l) in lights.iter().enumerate() {
-            if !l.is_valid() {
-                return Err(SceneError::InvalidLight(i));
-            }
-        }
-        if let Some(sky) = sky
-            && !valid_rgb(sky)
-        {
-            return Err(SceneError::InvalidSky);
-        }
-        let geometry = Geometry::new(&objects);
-
-        let light_sampler = LightSampler::new(&lights, sky.is_some());
-
-        // The radius of a box around camera, bounded objects and lights:
-        // only the far limit follows it (hit thresholds and spawn offsets
-        // are local to each ray and hit, see `surface::March`).
-        let mut lo = camera.position();
-        let mut hi = lo;
-        let mut include = |c: Vec3, r: f32| {
-            lo = lo.min(c - Vec3::splat(r));
-            hi = hi.max(c + Vec3::splat(r));
-        };
-        for o in &objects {
-            if let Some((c, r)) = o.sdf.bounding_sphere() {
-                include(c, r);
-            }
-        }
-        for l in &lights {
-            if let Some((l_lo, l_hi)) = l.bounds() {
-                lo = lo.min(l_lo);
-                hi = hi.max(l_hi);
-            }
-        }
-        let positive_or_one = |v: f32| if v.is_finite() && v > 0.0 { v } else { 1.0 };
-        let size = positive_or_one(0.5 * (hi - lo).length());
-
-        Ok(Scene {
-            objects,
-            materials,
-            lights,
-            sky,
-            camera,
+impl PreparedScene {
+    /// Prepares `scene`; validation is [`Scene::new`]'s.
+    pub fn new(scene: Scene) -> PreparedScene {
+        let geometry = Geometry::new(&scene.objects);
+        let light_sampler = LightSampler::new(&scene.lights, scene.sky.is_some());
+        let scale = scene.scale();
+        PreparedScene {
+            scene,
             geometry,
             light_sampler,
-            size,
-        })
+            scale,
+        }
     }
 
-    /// The scene's own length scale: the radius of a box around the camera,
-    /// the bounded objects and the lights. The far limit of rays is
-    /// proportional to it, and nothing else: no tolerance that decides where
-    /// a ray starts or stops depends on the size of the whole scene.
+    /// The scene this was prepared from.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// [`PreparedScene::scale`], computed once.
     pub fn scale(&self) -> f32 {
-        self.size
+        self.scale
     }
 
     /// The union of all objects as a distance field, evaluated as `marching` says (both
@@ -135,8 +67,8 @@ impl Scene {
     /// sampled as `quad_sampling` says.
     pub(crate) fn emitters(&self, quad_sampling: QuadSampling) -> Emitters<'_> {
         Emitters {
-            lights: &self.lights,
-            sky: self.sky,
+            lights: &self.scene.lights,
+            sky: self.scene.sky,
             sampler: &self.light_sampler,
             quad_sampling,
         }
@@ -145,6 +77,12 @@ impl Scene {
     /// Radiance emitted by light `light` toward `-ray.dir` from the point at
     /// `t` along `ray`.
     pub fn emitted(&self, light: usize, ray: &Ray, t: f32) -> Vec3 {
-        self.lights[light].emitted(ray, t)
+        self.scene.lights[light].emitted(ray, t)
+    }
+}
+
+impl From<Scene> for PreparedScene {
+    fn from(scene: Scene) -> PreparedScene {
+        PreparedScene::new(scene)
     }
 }

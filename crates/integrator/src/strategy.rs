@@ -6,8 +6,6 @@
 //! inputs (and the counters it is handed), so a tracer of batches of rays
 //! can call them per ray.
 
-use std::fmt;
-
 use glam::{Vec2, Vec3};
 use lueur_materials::{HemisphereSampling, Material};
 use lueur_sampling::{Sampler, power_heuristic};
@@ -15,7 +13,9 @@ use lueur_sdf_math::{Ray, TraceParams};
 
 use crate::light_sampler::Emitters;
 use crate::surface::{March, SurfacePoint};
-use crate::{Marching, RenderSettings, Scene, TraceCounters};
+use lueur_scene::{Marching, RenderSettings, Strategy};
+
+use crate::{PreparedScene, TraceCounters};
 
 /// Sampler dimensions consumed per path vertex, so that each bounce reads
 /// the same dimensions whatever happened before (low-discrepancy point sets
@@ -240,7 +240,7 @@ fn weighted(v: &Vertex, wi: Vec3, pdf: f32) -> Option<Scatter> {
 /// secondary rays are marched.
 #[derive(Clone, Copy)]
 pub(crate) struct Lighting<'a> {
-    pub scene: &'a Scene,
+    pub scene: &'a PreparedScene,
     pub emitters: Emitters<'a>,
     pub params: TraceParams,
     pub marching: Marching,
@@ -249,7 +249,7 @@ pub(crate) struct Lighting<'a> {
 impl<'a> Lighting<'a> {
     /// The lighting of `scene` rendered with `settings`, secondary rays marched as
     /// `march` says.
-    pub fn of(scene: &'a Scene, settings: &RenderSettings, march: &March) -> Lighting<'a> {
+    pub fn of(scene: &'a PreparedScene, settings: &RenderSettings, march: &March) -> Lighting<'a> {
         Lighting {
             scene,
             emitters: scene.emitters(settings.quad_sampling),
@@ -263,7 +263,7 @@ impl<'a> Lighting<'a> {
     pub fn delta_lights(&self, v: &Vertex, shadow: &mut TraceCounters) -> Vec3 {
         let (n, wo) = (v.at.n, v.wo);
         let mut sum = Vec3::ZERO;
-        for light in &self.scene.lights {
+        for light in &self.scene.scene().lights {
             let Some((wi, irradiance)) = light.delta_arrival() else {
                 continue;
             };
@@ -319,69 +319,6 @@ impl<'a> Lighting<'a> {
     }
 }
 
-/// How directions are chosen at a diffuse vertex: the knob lueur exists to
-/// measure. All strategies handle mirrors as delta events and directional
-/// lights by a shadow ray (a delta light can be reached no other way).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
-pub enum Strategy {
-    /// Uniform hemisphere directions (pdf 1/2pi); emission counted when a
-    /// path hits a light. The report's Figure 3.
-    Uniform,
-    /// Cosine-weighted hemisphere directions (pdf cos/pi), otherwise as
-    /// `Uniform`.
-    Cosine,
-    /// Directions toward the lights only (the report's Figure 4). Biased:
-    /// a direction that no light subtends has zero density, so light that
-    /// arrives only indirectly is never seen.
-    Light,
-    /// One-sample MIS (the report's Figure 5): the uniform hemisphere or a
-    /// light with probability 1/2 each, weighted by the mixture pdf (the
-    /// average of both). Unbiased.
-    Mixture,
-    /// Next-event estimation plus cosine BSDF sampling, combined with the
-    /// power heuristic (Veach 1997), as pbrt and Mitsuba do.
-    #[default]
-    Mis,
-}
-
-impl Strategy {
-    /// Every strategy, in the order the report introduces them.
-    pub const ALL: [Strategy; 5] = [
-        Strategy::Uniform,
-        Strategy::Cosine,
-        Strategy::Light,
-        Strategy::Mixture,
-        Strategy::Mis,
-    ];
-
-    /// The name used in scene files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Strategy::Uniform => "uniform",
-            Strategy::Cosine => "cosine",
-            Strategy::Light => "light",
-            Strategy::Mixture => "mixture",
-            Strategy::Mis => "mis",
-        }
-    }
-
-    /// Parses a name given by [`Strategy::name`].
-    pub fn from_name(name: &str) -> Option<Strategy> {
-        Strategy::ALL.into_iter().find(|s| s.name() == name)
-    }
-
-    /// Whether the estimator converges to the true radiance.
-    pub fn is_unbiased(self) -> bool {
-        self != Strategy::Light
-    }
-}
-
-impl fmt::Display for Strategy {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
 #[cfg(test)]
 mod tests {
     //! Each strategy's directions against the pdf it reports: Pearson's
@@ -389,7 +326,7 @@ mod tests {
     //! normal (`lueur_stats::DirectionBins`), after checking that the pdf
     //! each sample reports is the strategy's pdf at its direction.
     use super::*;
-    use crate::{Camera, Light, QuadSampling};
+    use lueur_scene::{Camera, Light, QuadSampling, Scene};
     use lueur_stats::DirectionBins;
 
     const N_SAMPLES: usize = 200_000;
@@ -443,7 +380,7 @@ mod tests {
 
     /// A sphere light and a quad light above the vertex, apart, facing it;
     /// and a sky if asked.
-    fn scene(sky: bool) -> Scene {
+    fn scene(sky: bool) -> PreparedScene {
         let lights = vec![
             Light::Sphere {
                 center: Vec3::new(-2.0, 3.0, 0.5),
@@ -459,7 +396,9 @@ mod tests {
         ];
         let camera = Camera::new(Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0).unwrap();
         let sky = sky.then_some(Vec3::splat(0.5));
-        Scene::new(vec![], vec![], lights, sky, camera).unwrap()
+        Scene::new(vec![], vec![], lights, sky, camera)
+            .unwrap()
+            .into()
     }
 
     /// Draws `sample` `N_SAMPLES` times; every reported pdf must be `pdf` at

@@ -8,7 +8,9 @@ use lueur_sdf_math::{
     position_rounding,
 };
 
-use crate::{Hit, Marching, RenderSettings, Scene};
+use lueur_scene::{Marching, RenderSettings};
+
+use crate::{Hit, PreparedScene};
 
 /// A hit on an object's surface, as [`crate::Hit::Surface`] reports it.
 #[derive(Clone, Copy, Debug)]
@@ -42,7 +44,7 @@ impl SurfaceHit {
 /// Marching parameters for one render. Only the far limit follows the scene's size; the
 /// hit thresholds are the pixel cone (camera rays) or a fraction of the distance travelled
 /// (secondary rays), raised per ray to what f32 resolves at its origin
-/// ([`TraceParams::resolving`], in `Scene`), and never depend on what else the scene holds.
+/// ([`TraceParams::resolving`], in `PreparedScene`), and never depend on what else the scene holds.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct March {
     pub camera: TraceParams,
@@ -58,13 +60,13 @@ pub(crate) struct March {
 }
 
 impl March {
-    pub fn new(scene: &Scene, settings: &RenderSettings) -> March {
+    pub fn new(scene: &PreparedScene, settings: &RenderSettings) -> March {
         let camera = TraceParams {
             t_min: 0.0,
             t_max: FAR_LIMIT * scene.scale(),
             max_steps: settings.max_steps,
             eps_abs: 0.0,
-            eps_rel: settings.pixel_epsilon * scene.camera.pixel_angle(settings.height),
+            eps_rel: settings.pixel_epsilon * scene.scene().camera.pixel_angle(settings.height),
         };
         let secondary = TraceParams {
             eps_rel: settings.epsilon_rel,
@@ -73,14 +75,14 @@ impl March {
         March {
             camera,
             secondary,
-            camera_inside: scene.distance(scene.camera.position(), settings.marching) < 0.0,
+            camera_inside: scene.distance(scene.scene().camera.position(), settings.marching) < 0.0,
             central_normals: settings.marching == Marching::Naive,
             marching: settings.marching,
         }
     }
 }
 
-/// Rays travel at most this many scene radii ([`Scene::scale`]): the one length that
+/// Rays travel at most this many scene radii ([`PreparedScene::scale`]): the one length that
 /// follows the whole scene, since where a ray gives up looking decides nothing about where
 /// it starts or stops on a surface.
 const FAR_LIMIT: f32 = 100.0;
@@ -155,7 +157,12 @@ pub(crate) struct SurfacePoint {
 impl SurfacePoint {
     /// The shading point of a hit on `object` at `t` along `ray` within a shell
     /// `epsilon` thick, on the field that marched it.
-    pub fn at_hit(scene: &Scene, march: &March, ray: &Ray, hit: SurfaceHit) -> SurfacePoint {
+    pub fn at_hit(
+        scene: &PreparedScene,
+        march: &March,
+        ray: &Ray,
+        hit: SurfaceHit,
+    ) -> SurfacePoint {
         let SurfaceHit {
             t,
             object,
@@ -166,9 +173,13 @@ impl SurfacePoint {
         let hit = ray.at(t);
         let precision = HitPrecision::at(scene.prepared(object), hit, epsilon, inside);
         match march.marching {
-            Marching::Naive => {
-                SurfacePoint::new(&scene.objects[object].sdf, hit, wo, precision, march)
-            }
+            Marching::Naive => SurfacePoint::new(
+                &scene.scene().objects[object].sdf,
+                hit,
+                wo,
+                precision,
+                march,
+            ),
             Marching::Fast => SurfacePoint::new(scene.prepared(object), hit, wo, precision, march),
         }
     }
@@ -287,8 +298,8 @@ impl SurfacePoint {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::ray_sphere;
     use lueur_materials::Material;
+    use lueur_scene::{Camera, Light, Object, Scene};
     use lueur_sdf_math::Sdf;
 
     /// A march with the default thresholds.
@@ -333,7 +344,12 @@ mod tests {
             for offset in [0.0f32, 0.27, 0.33] {
                 let origin = Vec3::new(offset, 0.0, 5.0);
                 let ray = Ray::new(origin, -Vec3::Z);
-                let t_true = ray_sphere(&ray, Vec3::ZERO, radius).unwrap();
+                let light = Light::Sphere {
+                    center: Vec3::ZERO,
+                    radius,
+                    radiance: Vec3::ONE,
+                };
+                let t_true = light.intersect(&ray).unwrap();
                 let x_true = ray.at(t_true);
                 let n_true = x_true / radius;
                 for depth in [0.0f32, 0.3, 0.6, 0.95] {
@@ -404,16 +420,17 @@ mod tests {
             let side = dir.any_orthonormal_vector();
             let origin = center - dir * 5.0 * size + side * aim * size;
             let ray = Ray::new(origin, dir);
-            let camera = crate::Camera::new(origin, center, dir.any_orthonormal_vector(), 40.0)
+            let camera = Camera::new(origin, center, dir.any_orthonormal_vector(), 40.0)
                 .unwrap();
             let mut offsets = Vec::new();
             for others in [rest_of_scene(0, 0.0), rest_of_scene(rest, cy - 2.0 * size)] {
                 let objects = std::iter::once(object.clone())
                     .chain(others)
-                    .map(|sdf| crate::Object { sdf, material: 0 })
+                    .map(|sdf| Object { sdf, material: 0 })
                     .collect();
                 let white = Material::Lambertian { albedo: Vec3::ONE };
-                let scene = Scene::new(objects, vec![white], vec![], None, camera).unwrap();
+                let scene: PreparedScene =
+                    Scene::new(objects, vec![white], vec![], None, camera).unwrap().into();
                 let march = March::new(&scene, &RenderSettings::default());
                 let mut counters = crate::TraceCounters::default();
                 let Some(Hit::Surface { t, object: 0, epsilon, .. }) =

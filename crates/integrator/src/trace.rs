@@ -7,7 +7,9 @@ use glam::Vec3;
 
 use lueur_sdf_math::{DistanceField, Ray, TraceOutcome, TraceParams, sphere_trace};
 
-use crate::{Marching, Scene};
+use lueur_scene::Marching;
+
+use crate::PreparedScene;
 
 /// What a ray found first.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -16,7 +18,7 @@ pub enum Hit {
     Surface {
         /// Ray parameter.
         t: f32,
-        /// Index into [`Scene::objects`].
+        /// Index into `Scene::objects`.
         object: usize,
         /// How thick the shell the tracer stopped in is: the hit threshold in
         /// force at that distance, or, for a ray that gave up at the step cap,
@@ -32,7 +34,7 @@ pub enum Hit {
     Light {
         /// Ray parameter.
         t: f32,
-        /// Index into [`Scene::lights`].
+        /// Index into `Scene::lights`.
         light: usize,
     },
 }
@@ -123,7 +125,7 @@ impl TraceCounters {
     }
 }
 
-impl Scene {
+impl PreparedScene {
     /// Finds the first object or light along `ray`.
     pub fn intersect(
         &self,
@@ -135,7 +137,7 @@ impl Scene {
         self.intersect_leaving(ray, ray.origin, params, marching, counters, false)
     }
 
-    /// [`Scene::intersect`] for a ray that may start inside a solid: a
+    /// [`PreparedScene::intersect`] for a ray that may start inside a solid: a
     /// camera ray, or a ray leaving a surface that was shaded on its inside.
     /// If its origin is below a surface (not merely in its shell), the ray
     /// is marched by the negated field to the wall it leaves through, so
@@ -154,7 +156,7 @@ impl Scene {
         self.intersect_leaving(ray, ray.origin, params, marching, counters, true)
     }
 
-    /// [`Scene::intersect`] (or, with `maybe_inside`, [`Scene::intersect_maybe_inside`])
+    /// [`PreparedScene::intersect`] (or, with `maybe_inside`, [`PreparedScene::intersect_maybe_inside`])
     /// for a ray leaving the surface point `from`: the objects are marched from
     /// `ray.origin`, lifted off the surface so that the march does not stop on it at once,
     /// but the lights, which are exact, are intersected from `from` itself. So a light is
@@ -179,7 +181,7 @@ impl Scene {
         let light_hit = self.intersect_lights(&light_ray, params.t_max, None);
         let t_max = light_hit.map_or(params.t_max, |(t, _)| t);
         let mut surface = None;
-        if !self.objects.is_empty() {
+        if !self.scene().objects.is_empty() {
             let p = TraceParams { t_max, ..params };
             let start = ray.at(p.t_min);
             let inside = maybe_inside
@@ -247,7 +249,7 @@ impl Scene {
             {
                 break 'free false;
             }
-            if self.objects.is_empty() || t_max <= params.t_min {
+            if self.scene().objects.is_empty() || t_max <= params.t_min {
                 break 'free true;
             }
             let (outcome, _) =
@@ -263,7 +265,7 @@ impl Scene {
 
     fn intersect_lights(&self, ray: &Ray, t_max: f32, skip: Option<usize>) -> Option<(f32, usize)> {
         let mut best: Option<(f32, usize)> = None;
-        for (i, l) in self.lights.iter().enumerate() {
+        for (i, l) in self.scene().lights.iter().enumerate() {
             if Some(i) == skip {
                 continue;
             }
@@ -282,15 +284,17 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Camera;
     use crate::geometry::tests::{crowd, points};
     use lueur_materials::Material;
+    use lueur_scene::{Camera, Scene};
 
     /// [`crate::geometry::tests::crowd`] as a scene.
-    fn crowd_scene() -> Scene {
+    fn crowd_scene() -> PreparedScene {
         let camera = Camera::new(Vec3::new(0.0, 0.5, 6.0), Vec3::ZERO, Vec3::Y, 40.0).unwrap();
         let white = Material::Lambertian { albedo: Vec3::ONE };
-        Scene::new(crowd(), vec![white], vec![], None, camera).unwrap()
+        Scene::new(crowd(), vec![white], vec![], None, camera)
+            .unwrap()
+            .into()
     }
 
     #[test]

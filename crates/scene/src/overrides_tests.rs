@@ -1,6 +1,8 @@
 //! `--set`: overrides reach the scene through the file's own checks, and
 //! their errors point at the override.
 
+use glam::Vec3;
+
 use super::*;
 
 const BASE: &str = r#"[render]

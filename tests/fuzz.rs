@@ -13,15 +13,15 @@
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use lueur_integrator::render;
-use lueur_scene::{SceneFileError, parse_scene};
+use lueur::integrator::{PreparedScene, render};
+use lueur::scene::{SceneFileError, parse_scene};
 use proptest::prelude::*;
 use proptest::sample::{Index, select};
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
 const SEEDS: [&str; 2] = [
-    include_str!("../../../scenes/cornell-spheres.toml"),
-    include_str!("../../../scenes/donut-mirrors.toml"),
+    include_str!("../scenes/cornell-spheres.toml"),
+    include_str!("../scenes/donut-mirrors.toml"),
 ];
 
 /// Longest a single input may take to parse and render at 2x2, 1 spp. A
@@ -416,7 +416,7 @@ fn check(text: &str) -> Result<(), SceneFileError> {
         settings.width = 2;
         settings.height = 2;
         settings.spp = 1;
-        let out = render(&parsed.scene, &settings, &|_| {})
+        let out = render(&PreparedScene::new(parsed.scene), &settings, &|_| {})
             .unwrap_or_else(|e| panic!("a scene that parsed does not render: {e}"));
         Ok(out)
     });

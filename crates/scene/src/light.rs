@@ -1,7 +1,7 @@
 //! Light sources, one unit: every kind answers here whether it is valid, where a ray meets
 //! it, what it emits toward a ray, how a direction toward it is sampled and with what pdf,
 //! and the box it occupies. [`Light`] is matched in this module and nowhere else, so a new
-//! kind of light is written here (and parsed in `lueur-scene`).
+//! kind of light is written here (and parsed in `file.rs`).
 
 use glam::{Vec2, Vec3};
 use lueur_sampling::{
@@ -59,9 +59,13 @@ pub enum QuadSampling {
 
 /// A direction toward a light (or the sky) with the radiance it brings.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct EmitterSample {
+pub struct EmitterSample {
+    /// Unit direction from the shading point toward the emitter.
     pub wi: Vec3,
+    /// Distance to the emitter along `wi` (infinite for the sky and lights
+    /// at infinity).
     pub distance: f32,
+    /// Radiance arriving along `-wi`.
     pub radiance: Vec3,
     /// Solid-angle pdf of `wi` (including, once chosen by the light
     /// sampler, the probability of choosing this emitter).
@@ -77,7 +81,7 @@ impl Light {
 
     /// Whether the light can be rendered: a positive size, finite position
     /// and non-negative radiance.
-    pub(crate) fn is_valid(&self) -> bool {
+    pub fn is_valid(&self) -> bool {
         match *self {
             Light::Sphere {
                 center,
@@ -103,7 +107,7 @@ impl Light {
 
     /// The corners of a box around the light, `None` for a light at
     /// infinity.
-    pub(crate) fn bounds(&self) -> Option<(Vec3, Vec3)> {
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         match *self {
             Light::Sphere { center, radius, .. } => {
                 Some((center - Vec3::splat(radius), center + Vec3::splat(radius)))
@@ -123,7 +127,7 @@ impl Light {
 
     /// Where `ray` first meets the light's surface (lights at infinity are
     /// never met).
-    pub(crate) fn intersect(&self, ray: &Ray) -> Option<f32> {
+    pub fn intersect(&self, ray: &Ray) -> Option<f32> {
         match *self {
             Light::Sphere { center, radius, .. } => ray_sphere(ray, center, radius),
             Light::Quad {
@@ -137,7 +141,7 @@ impl Light {
     }
 
     /// Radiance emitted toward `-ray.dir` from the point at `t` along `ray`.
-    pub(crate) fn emitted(&self, ray: &Ray, t: f32) -> Vec3 {
+    pub fn emitted(&self, ray: &Ray, t: f32) -> Vec3 {
         match *self {
             Light::Sphere {
                 center, radiance, ..
@@ -167,7 +171,7 @@ impl Light {
 
     /// For a delta light, the one direction its light arrives from and the
     /// irradiance it brings there.
-    pub(crate) fn delta_arrival(&self) -> Option<(Vec3, Vec3)> {
+    pub fn delta_arrival(&self) -> Option<(Vec3, Vec3)> {
         match *self {
             Light::Directional {
                 direction,
@@ -180,12 +184,7 @@ impl Light {
     /// A direction from `p` toward the light's emitting surface, with its
     /// solid-angle pdf; `None` where the sample has no weight (a back face,
     /// a delta light).
-    pub(crate) fn sample(
-        &self,
-        p: Vec3,
-        u: Vec2,
-        quad_sampling: QuadSampling,
-    ) -> Option<EmitterSample> {
+    pub fn sample(&self, p: Vec3, u: Vec2, quad_sampling: QuadSampling) -> Option<EmitterSample> {
         let (s, radiance): (DirectionSample, Vec3) = match *self {
             Light::Sphere {
                 center,
@@ -229,7 +228,7 @@ impl Light {
     }
 
     /// Solid-angle pdf with which [`Light::sample`] picks `wi` from `p`.
-    pub(crate) fn pdf(&self, p: Vec3, wi: Vec3, quad_sampling: QuadSampling) -> f32 {
+    pub fn pdf(&self, p: Vec3, wi: Vec3, quad_sampling: QuadSampling) -> f32 {
         match *self {
             Light::Sphere { center, radius, .. } => {
                 // Directions that reach the sphere from inside hit its
