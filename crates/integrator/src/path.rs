@@ -10,7 +10,7 @@ use lueur_sdf_math::Ray;
 
 use crate::strategy::{self, EmissionWeight, Lighting, Scatter, Vertex, VertexSample};
 use crate::surface::{March, SurfaceHit, SurfacePoint};
-use lueur_scene::{RenderSettings, Strategy};
+use lueur_scene::RenderSettings;
 
 use crate::{Hit, PreparedScene, TraceCounters};
 
@@ -31,6 +31,16 @@ impl RayCounters {
         self.camera.merge(&o.camera);
         self.bounce.merge(&o.bounce);
         self.shadow.merge(&o.shadow);
+    }
+
+    /// The counters of the ray that leaves vertex `depth` of a path (the
+    /// camera's at 0).
+    fn path_ray(&mut self, depth: u32) -> &mut TraceCounters {
+        if depth == 0 {
+            &mut self.camera
+        } else {
+            &mut self.bounce
+        }
     }
 }
 
@@ -96,11 +106,7 @@ pub(crate) fn radiance(
     let mut depth = 0u32;
     let mut params = march.camera;
     loop {
-        let kind = if depth == 0 {
-            &mut counters.camera
-        } else {
-            &mut counters.bounce
-        };
+        let kind = counters.path_ray(depth);
         let maybe_inside = depth == 0 && march.camera_inside || previous.in_solid;
         let hit = scene.intersect_leaving(
             &ray,
@@ -125,16 +131,15 @@ pub(crate) fn radiance(
         };
         let u = VertexSample::draw(sampler, id.pixel, id.index, depth);
 
-        let scatter: Option<Scatter> = match vertex.material {
-            Material::Mirror { .. } => strategy::mirror(&vertex, u.bsdf),
-            Material::Lambertian { .. } => {
-                radiance += beta * lighting.delta_lights(&vertex, &mut counters.shadow);
-                if settings.strategy == Strategy::Mis {
-                    radiance += beta * lighting.next_event(&vertex, &u, &mut counters.shadow);
-                }
-                strategy::scatter(settings.strategy, &lighting.emitters, &vertex, &u)
-            }
-        };
+        let through = (beta, &mut radiance);
+        let scatter = shade(
+            &lighting,
+            settings,
+            &vertex,
+            &u,
+            through,
+            &mut counters.shadow,
+        );
         let Some(scatter) = scatter else {
             break;
         };
@@ -159,6 +164,30 @@ pub(crate) fn radiance(
         }
     }
     radiance
+}
+
+/// Adds to `radiance` the light a vertex gathers by shadow rays (delta
+/// lights, and next-event estimation where the strategy uses it), times
+/// the path's throughput `beta`; gives the direction the path scatters in:
+/// the material's for a mirror, the strategy's at a diffuse vertex.
+fn shade(
+    lighting: &Lighting<'_>,
+    settings: &RenderSettings,
+    vertex: &Vertex,
+    u: &VertexSample,
+    (beta, radiance): (Vec3, &mut Vec3),
+    shadow: &mut TraceCounters,
+) -> Option<Scatter> {
+    match vertex.material {
+        Material::Mirror { .. } => strategy::mirror(vertex, u.bsdf),
+        Material::Lambertian { .. } => {
+            *radiance += beta * lighting.delta_lights(vertex, shadow);
+            if strategy::uses_next_event(settings.strategy) {
+                *radiance += beta * lighting.next_event(vertex, u, shadow);
+            }
+            strategy::scatter(settings.strategy, &lighting.emitters, vertex, u)
+        }
+    }
 }
 
 /// What the path gains where it leaves the objects: the sky on a miss, or a

@@ -149,6 +149,17 @@ pub(crate) fn scatter(
     }
 }
 
+/// Whether `strategy` adds next-event estimation (a shadow ray toward a
+/// chosen emitter) at each diffuse vertex, besides the direction it
+/// scatters in; the weight of emission found along that direction then
+/// accounts for it.
+pub(crate) fn uses_next_event(strategy: Strategy) -> bool {
+    match strategy {
+        Strategy::Mis => true,
+        Strategy::Uniform | Strategy::Cosine | Strategy::Light | Strategy::Mixture => false,
+    }
+}
+
 /// `uniform` and `cosine`: BSDF sampling over the hemisphere; emission found
 /// later counts in full.
 pub(crate) fn hemisphere(v: &Vertex, hemisphere: HemisphereSampling, u: Vec2) -> Option<Scatter> {

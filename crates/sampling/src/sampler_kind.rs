@@ -171,6 +171,26 @@ impl SamplerKind {
         !matches!(self, SamplerKind::Halton | SamplerKind::Sobol)
     }
 
+    /// One line on the construction, for `--help`.
+    pub fn summary(&self) -> &'static str {
+        match self {
+            SamplerKind::Independent => "independent uniform random numbers (PCG32)",
+            SamplerKind::Stratified => "jittered strata over the total spp",
+            SamplerKind::Lhs => "Latin hypercube over the total spp",
+            SamplerKind::Cmj => "correlated multi-jittered (Kensler 2013) over the total spp",
+            SamplerKind::Halton => "plain Halton sequence, unrandomized (to measure, not to use)",
+            SamplerKind::HaltonOwen => "Halton sequence, Owen-scrambled per pixel",
+            SamplerKind::Sobol => "plain Sobol' sequence, unrandomized (to measure, not to use)",
+            SamplerKind::SobolXor => "Sobol' sequence, random digital shift (default)",
+            SamplerKind::SobolOwen => "padded Owen-scrambled Sobol' (Burley 2020)",
+            SamplerKind::ZSobol => {
+                "pbrt-v4's ZSobol: blue-noise error across pixels; total spp fixed"
+            }
+            SamplerKind::R2 => "R2 Kronecker sequence, rotated per pixel",
+            SamplerKind::Pmj02 => "progressive multi-jittered (0,2) sequences",
+        }
+    }
+
     /// The lowercase name used on command lines and in scene files: the
     /// registry's name of its construction.
     pub const fn name(&self) -> &'static str {

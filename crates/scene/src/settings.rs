@@ -235,6 +235,19 @@ impl Strategy {
         Strategy::ALL.into_iter().find(|s| s.name() == name)
     }
 
+    /// One line on what the strategy does, for `--help`.
+    pub fn summary(self) -> &'static str {
+        match self {
+            Strategy::Uniform => "uniform hemisphere directions; lights counted when hit",
+            Strategy::Cosine => "cosine-weighted hemisphere directions; lights counted when hit",
+            Strategy::Light => "directions toward the lights only (biased: misses indirect light)",
+            Strategy::Mixture => "one-sample MIS: hemisphere or light with probability 1/2 each",
+            Strategy::Mis => {
+                "next-event estimation + cosine BSDF sampling, power heuristic (default)"
+            }
+        }
+    }
+
     /// Whether the estimator converges to the true radiance.
     pub fn is_unbiased(self) -> bool {
         self != Strategy::Light
