@@ -25,17 +25,14 @@ fn furnace_objects() -> Vec<Sdf> {
     vec![
         Sdf::Translate {
             offset: Vec3::new(-0.6, 0.0, 0.0),
-            child: Box::new(Sdf::Sphere { radius: 0.45 }),
+            child: Box::new(Sdf::sphere(0.45)),
         },
         // A torus is not convex: paths bounce on it more than once.
         Sdf::Translate {
             offset: Vec3::new(0.55, 0.0, 0.0),
             child: Box::new(Sdf::Rotate {
                 rotation: Quat::from_rotation_x(1.1),
-                child: Box::new(Sdf::Torus {
-                    major_radius: 0.4,
-                    minor_radius: 0.15,
-                }),
+                child: Box::new(Sdf::torus(0.4, 0.15)),
             }),
         },
     ]
@@ -166,10 +163,7 @@ fn direct_light_mismatches(
 ) -> Vec<String> {
     let mut wrong = Vec::new();
     let camera = Camera::new(Vec3::new(0.0, 1.0, 3.0), Vec3::ZERO, Vec3::Y, 0.02).unwrap();
-    let plane = Sdf::Plane {
-        normal: Vec3::Y,
-        height: 0.0,
-    };
+    let plane = Sdf::plane(Vec3::Y, 0.0);
     let scene = scene_of(
         vec![plane],
         Material::Lambertian {

@@ -43,7 +43,7 @@ fn scene() -> Scene {
     let grey = Material::Lambertian {
         albedo: Vec3::splat(0.5),
     };
-    let objects = vec![Sdf::Sphere { radius: 0.5 }, Sdf::plane(Vec3::Y, -0.5)];
+    let objects = vec![Sdf::sphere(0.5), Sdf::plane(Vec3::Y, -0.5)];
     scene_of(objects, grey, vec![], Some(Vec3::ONE), camera)
 }
 

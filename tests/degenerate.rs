@@ -208,7 +208,7 @@ fn camera_inside_an_object_renders() {
         albedo: Vec3::splat(0.8),
     };
     let scene = scene_of(
-        vec![Sdf::Sphere { radius: 1.0 }],
+        vec![Sdf::sphere(1.0)],
         white,
         vec![light],
         Some(Vec3::ONE),
@@ -249,14 +249,10 @@ fn light_inside_a_closed_object_is_hidden() {
         albedo: Vec3::splat(0.8),
     };
     let objects = vec![
-        Sdf::Box {
-            half_extents: Vec3::splat(0.6),
-        },
+        Sdf::cuboid(Vec3::splat(0.6)),
         Sdf::Translate {
             offset: Vec3::new(0.0, -0.7, 0.0),
-            child: Box::new(Sdf::Box {
-                half_extents: Vec3::new(3.0, 0.05, 3.0),
-            }),
+            child: Box::new(Sdf::cuboid(Vec3::new(3.0, 0.05, 3.0))),
         },
     ];
     let scene = scene_of(objects, white, vec![light], None, camera);

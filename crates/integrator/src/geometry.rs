@@ -7,8 +7,8 @@ use std::cell::Cell;
 
 use glam::Vec3;
 use lueur_sdf_math::{
-    Aabb, DistanceField, HalfSpace, OVER_RELAXATION, PreparedSdf, Ray, RayClip, Sdf, TraceOutcome,
-    TraceParams, sphere_trace, sphere_trace_relaxed,
+    Aabb, DistanceField, HalfSpace, OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClip, Sdf,
+    TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed,
 };
 use smallvec::SmallVec;
 
@@ -282,7 +282,7 @@ impl Geometry {
 /// so checking the bound would cost as much as evaluating it.
 fn is_sphere(sdf: &Sdf) -> bool {
     match sdf {
-        Sdf::Sphere { .. } => true,
+        Sdf::Primitive(Primitive::Sphere { .. }) => true,
         Sdf::Translate { child, .. } => is_sphere(child),
         _ => false,
     }
@@ -291,7 +291,7 @@ fn is_sphere(sdf: &Sdf) -> bool {
 /// Whether the shape is a box, possibly moved: its bounding box is the shape itself.
 fn is_box(sdf: &Sdf) -> bool {
     match sdf {
-        Sdf::Box { .. } => true,
+        Sdf::Primitive(Primitive::Box { .. }) => true,
         Sdf::Translate { child, .. } => is_box(child),
         _ => false,
     }

@@ -36,7 +36,7 @@
 //! // A white sphere under a uniform white sky: a furnace, radiance 1.
 //! let camera = Camera::new(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 30.0).unwrap();
 //! let scene = Scene::new(
-//!     vec![Object { sdf: Sdf::Sphere { radius: 0.5 }, material: 0 }],
+//!     vec![Object { sdf: Sdf::sphere(0.5), material: 0 }],
 //!     vec![Material::Lambertian { albedo: Vec3::ONE }],
 //!     Vec::<Light>::new(),
 //!     Some(Vec3::ONE),

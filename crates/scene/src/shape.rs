@@ -89,18 +89,14 @@ fn parse_primitive(src: &Source<'_>, t: &Table<'_, '_>, kind: &str) -> Result<Op
         "sphere" => {
             allow(&["center", "radius"])?;
             (
-                Sdf::Sphere {
-                    radius: t.req_f32(src, "radius", Check::Positive)?,
-                },
+                Sdf::sphere(t.req_f32(src, "radius", Check::Positive)?),
                 center(t)?,
             )
         }
         "box" => {
             allow(&["center", "half_extents"])?;
             (
-                Sdf::Box {
-                    half_extents: t.req_vec3(src, "half_extents", Check::Positive)?,
-                },
+                Sdf::cuboid(t.req_vec3(src, "half_extents", Check::Positive)?),
                 center(t)?,
             )
         }
@@ -116,54 +112,32 @@ fn parse_primitive(src: &Source<'_>, t: &Table<'_, '_>, kind: &str) -> Result<Op
                     "must not exceed the smallest half extent",
                 ));
             }
-            (
-                Sdf::RoundBox {
-                    half_extents,
-                    radius,
-                },
-                center(t)?,
-            )
+            (Sdf::round_box(half_extents, radius), center(t)?)
         }
         "plane" => {
             allow(&["normal", "height"])?;
-            let normal = t.req_vec3(src, "normal", Check::NonZeroVector)?.normalize();
+            let normal = t.req_vec3(src, "normal", Check::NonZeroVector)?;
             let height = t.opt_f32(src, "height", Check::Any, 0.0)?;
-            (Sdf::Plane { normal, height }, Vec3::ZERO)
+            (Sdf::plane(normal, height), Vec3::ZERO)
         }
         "torus" => {
             allow(&["center", "major_radius", "minor_radius"])?;
             let major_radius = t.req_f32(src, "major_radius", Check::Positive)?;
             let minor_radius = t.req_f32(src, "minor_radius", Check::Positive)?;
-            (
-                Sdf::Torus {
-                    major_radius,
-                    minor_radius,
-                },
-                center(t)?,
-            )
+            (Sdf::torus(major_radius, minor_radius), center(t)?)
         }
         "capped_cylinder" => {
             allow(&["center", "radius", "half_height"])?;
             let radius = t.req_f32(src, "radius", Check::Positive)?;
             let half_height = t.req_f32(src, "half_height", Check::Positive)?;
-            (
-                Sdf::CappedCylinder {
-                    radius,
-                    half_height,
-                },
-                center(t)?,
-            )
+            (Sdf::capped_cylinder(radius, half_height), center(t)?)
         }
         "capsule" => {
             allow(&["a", "b", "radius"])?;
             let a = t.req_vec3(src, "a", Check::Any)?;
             let b = t.req_vec3(src, "b", Check::Any)?;
             (
-                Sdf::Capsule {
-                    a,
-                    b,
-                    radius: t.req_f32(src, "radius", Check::Positive)?,
-                },
+                Sdf::capsule(a, b, t.req_f32(src, "radius", Check::Positive)?),
                 Vec3::ZERO,
             )
         }
@@ -172,7 +146,7 @@ fn parse_primitive(src: &Source<'_>, t: &Table<'_, '_>, kind: &str) -> Result<Op
             let ra = t.req_f32(src, "ra", Check::Positive)?;
             let rb = t.req_f32(src, "rb", Check::Positive)?;
             let d = t.req_f32(src, "d", Check::Positive)?;
-            (Sdf::DeathStar { ra, rb, d }, center(t)?)
+            (Sdf::death_star(ra, rb, d), center(t)?)
         }
         _ => return Ok(None),
     };

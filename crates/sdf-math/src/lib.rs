@@ -4,7 +4,9 @@
 //! blends and rigid transforms. The design decision that shapes the crate: a scene's
 //! geometry is a *value* evaluated by `match`, never a trait object, so the hot loop of the
 //! tracer has no virtual calls and no allocation. Anything else that wants to be traced
-//! implements the two-method [`DistanceField`] trait.
+//! implements the two-method [`DistanceField`] trait. The tree's leaves are
+//! [`Primitive`]s, each with its distance, Lipschitz bound, exactness and bounds in one
+//! place; the operators and transforms delegate to them and never name one.
 //!
 //! Around the tree: bounds a tracer can clip rays against before marching them
 //! ([`Sdf::bounding_box`], [`Sdf::bounding_half_space`], with [`RayClip`] giving the exact
@@ -62,6 +64,7 @@ pub use crate::bound::{Aabb, HalfSpace, RayClip};
 pub use crate::field::DistanceField;
 pub use crate::normal::{FALLBACK_NORMAL, gradient, gradient_central, normal, normal_central};
 pub use crate::prepared::PreparedSdf;
+pub use crate::primitives::Primitive;
 pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
 pub use crate::trace::{

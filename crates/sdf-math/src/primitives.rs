@@ -1,19 +1,323 @@
-//! Exact signed distances to the primitive shapes, after iq's "distfunctions" article
-//! (iquilezles.org/articles/distfunctions). Each function clamps degenerate parameters
+//! The primitive shapes, each in one place: its parameters ([`Primitive`]), its signed
+//! distance, Lipschitz bound and exactness, its bounds, and the [`Sdf`] constructor that
+//! makes it. A new primitive is a variant here, its arms of the `impl Primitive` matches
+//! and a constructor; the tree in `sdf.rs` and its bounds in `sdf_bounds.rs` only
+//! delegate to [`Primitive`] and never name one.
+//!
+//! The distances are exact, after iq's "distfunctions" article
+//! (iquilezles.org/articles/distfunctions). Each formula clamps degenerate parameters
 //! (negative sizes) to the nearest meaningful shape instead of trusting them, so that the
-//! "exact" claims in `Sdf::is_exact` hold for every finite input.
+//! "exact" claims of [`Primitive::is_exact`] hold for every finite input.
 
 use glam::{Vec2, Vec3};
 
+use crate::Sdf;
+use crate::bound::{Aabb, HalfSpace};
+
+/// A primitive shape in its own frame, the leaves of the [`Sdf`] tree
+/// ([`Sdf::Primitive`]); move, turn or scale it with the tree's transforms.
+///
+/// The per-variant notes give the Lipschitz bound and whether the value is the exact
+/// Euclidean distance ([`Primitive::is_exact`]) or only a bound.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Primitive {
+    /// Sphere centred at the origin. Exact; L = 1.
+    Sphere {
+        /// Radius; negative is treated as 0 (a point).
+        radius: f32,
+    },
+    /// Axis-aligned box centred at the origin (iq sdBox). Exact; L = 1.
+    Box {
+        /// Half the side lengths; negative components are treated as 0.
+        half_extents: Vec3,
+    },
+    /// Box with rounded edges (iq sdRoundBox); the outer size is still `half_extents`.
+    /// Exact; L = 1.
+    RoundBox {
+        /// Half the side lengths of the outer box; negative components are treated as 0.
+        half_extents: Vec3,
+        /// Edge radius, clamped to `[0, smallest half extent]`.
+        radius: f32,
+    },
+    /// Half-space below a plane: `distance = dot(p, normal) - height`. Exact with L = 1
+    /// when `normal` is unit (as [`Sdf::plane`] makes it); otherwise L = `|normal|` (or 1
+    /// if smaller) and only a bound.
+    Plane {
+        /// Outward unit normal.
+        normal: Vec3,
+        /// Offset of the plane along `normal`.
+        height: f32,
+    },
+    /// Torus: a ring in the XZ plane around the Y axis (iq sdTorus). L = 1; exact unless
+    /// `minor_radius > major_radius` (a self-intersecting spindle torus), where it is exact
+    /// outside and a bound inside.
+    Torus {
+        /// Radius of the core circle; negative is treated as 0.
+        major_radius: f32,
+        /// Radius of the tube; negative is treated as 0.
+        minor_radius: f32,
+    },
+    /// Cylinder with flat caps, axis Y, centred at the origin (iq sdCappedCylinder).
+    /// Exact; L = 1.
+    CappedCylinder {
+        /// Radius; negative is treated as 0.
+        radius: f32,
+        /// Half the height; negative is treated as 0.
+        half_height: f32,
+    },
+    /// Points within `radius` of the segment `ab` (iq sdCapsule). Exact; L = 1.
+    Capsule {
+        /// One end of the core segment.
+        a: Vec3,
+        /// The other end of the core segment.
+        b: Vec3,
+        /// Radius; negative is treated as 0.
+        radius: f32,
+    },
+    /// Sphere of radius `ra` at the origin minus a sphere of radius `rb` at `(d, 0, 0)`
+    /// (iq sdDeathStar). Exact; L = 1. When the small sphere swallows the big one nothing
+    /// is left and the value is a positive bound instead.
+    DeathStar {
+        /// Radius of the kept sphere; negative is treated as 0.
+        ra: f32,
+        /// Radius of the carved sphere; negative is treated as 0.
+        rb: f32,
+        /// Offset of the carved sphere along x (either sign).
+        d: f32,
+    },
+}
+
+impl Primitive {
+    /// Signed distance (or bound, see the variant) at `p`; negative inside.
+    #[inline]
+    pub fn distance(&self, p: Vec3) -> f32 {
+        match *self {
+            Self::Sphere { radius } => sphere(p, radius),
+            Self::Box { half_extents } => cuboid(p, half_extents),
+            Self::RoundBox {
+                half_extents,
+                radius,
+            } => round_box(p, half_extents, radius),
+            Self::Plane { normal, height } => plane(p, normal, height),
+            Self::Torus {
+                major_radius,
+                minor_radius,
+            } => torus(p, major_radius, minor_radius),
+            Self::CappedCylinder {
+                radius,
+                half_height,
+            } => capped_cylinder(p, radius, half_height),
+            Self::Capsule { a, b, radius } => capsule(p, a, b, radius),
+            Self::DeathStar { ra, rb, d } => death_star(p, ra, rb, d),
+        }
+    }
+
+    /// Lipschitz bound L of [`Primitive::distance`]: 1, or `|normal|` for a plane with a
+    /// longer than unit normal.
+    pub fn lipschitz(&self) -> f32 {
+        match self {
+            Self::Sphere { .. }
+            | Self::Box { .. }
+            | Self::RoundBox { .. }
+            | Self::Torus { .. }
+            | Self::CappedCylinder { .. }
+            | Self::Capsule { .. }
+            | Self::DeathStar { .. } => 1.0,
+            // NaN.max(1.0) is 1.0, but a NaN normal makes NaN distances, which the tracer
+            // reports as GaveUp anyway.
+            Self::Plane { normal, .. } => normal.length().max(1.0),
+        }
+    }
+
+    /// True where [`Primitive::distance`] is the exact signed Euclidean distance to the
+    /// surface everywhere, inside and out: all but a plane with a non-unit normal, a
+    /// spindle torus and an empty Death Star.
+    pub fn is_exact(&self) -> bool {
+        match self {
+            Self::Sphere { .. }
+            | Self::Box { .. }
+            | Self::RoundBox { .. }
+            | Self::CappedCylinder { .. }
+            | Self::Capsule { .. } => true,
+            Self::Plane { normal, .. } => unit_length(*normal),
+            Self::Torus {
+                major_radius,
+                minor_radius,
+            } => major_radius.max(0.0) >= minor_radius.max(0.0),
+            Self::DeathStar { ra, rb, d } => death_star_kind(*ra, *rb, *d) != DeathStarKind::Empty,
+        }
+    }
+
+    /// True where [`Primitive::distance`] is exact at every point outside the shape:
+    /// everything [`Primitive::is_exact`] accepts, and the spindle torus.
+    pub fn is_exact_outside(&self) -> bool {
+        match self {
+            Self::Torus { .. } => true,
+            _ => self.is_exact(),
+        }
+    }
+
+    /// The bounding sphere `(centre, radius)` with the field contract of
+    /// [`Sdf::bounding_sphere`], `None` for a plane; not yet checked for finiteness.
+    pub(crate) fn bounding_sphere(&self) -> Option<(Vec3, f32)> {
+        match self {
+            Self::Sphere { radius } => Some((Vec3::ZERO, radius.max(0.0))),
+            Self::Box { half_extents } | Self::RoundBox { half_extents, .. } => {
+                Some((Vec3::ZERO, half_extents.max(Vec3::ZERO).length()))
+            }
+            Self::Plane { .. } => None,
+            Self::Torus {
+                major_radius,
+                minor_radius,
+            } => Some((Vec3::ZERO, major_radius.max(0.0) + minor_radius.max(0.0))),
+            Self::CappedCylinder {
+                radius,
+                half_height,
+            } => Some((
+                Vec3::ZERO,
+                Vec2::new(*radius, *half_height).max(Vec2::ZERO).length(),
+            )),
+            Self::Capsule { a, b, radius } => {
+                Some(((*a + *b) * 0.5, (*b - *a).length() * 0.5 + radius.max(0.0)))
+            }
+            Self::DeathStar { ra, .. } => Some((Vec3::ZERO, ra.max(0.0))),
+        }
+    }
+
+    /// The bounding box with the field contract of [`Sdf::bounding_box`], `None` for a
+    /// plane; not yet checked for finiteness.
+    pub(crate) fn bounding_box(&self) -> Option<Aabb> {
+        let centered = |half: Vec3| Some(Aabb::from_center(Vec3::ZERO, half.max(Vec3::ZERO)));
+        match self {
+            Self::Sphere { radius } => centered(Vec3::splat(*radius)),
+            Self::Box { half_extents } | Self::RoundBox { half_extents, .. } => {
+                centered(*half_extents)
+            }
+            Self::Plane { .. } => None,
+            Self::Torus {
+                major_radius,
+                minor_radius,
+            } => {
+                let (big, small) = (major_radius.max(0.0), minor_radius.max(0.0));
+                centered(Vec3::new(big + small, small, big + small))
+            }
+            Self::CappedCylinder {
+                radius,
+                half_height,
+            } => centered(Vec3::new(*radius, *half_height, *radius)),
+            Self::Capsule { a, b, radius } => {
+                let r = Vec3::splat(radius.max(0.0));
+                Some(Aabb {
+                    min: a.min(*b) - r,
+                    max: a.max(*b) + r,
+                })
+            }
+            // The field is at least the distance to the kept sphere (the rim circle lies
+            // on it), so that sphere's box will do.
+            Self::DeathStar { ra, .. } => centered(Vec3::splat(*ra)),
+        }
+    }
+
+    /// The half-space with the field contract of [`Sdf::bounding_half_space`]: a plane's
+    /// own (equality: the field is that linear function), `None` for every bounded shape;
+    /// not yet checked for finiteness.
+    pub(crate) fn bounding_half_space(&self) -> Option<HalfSpace> {
+        match self {
+            Self::Plane { normal, height } => Some(HalfSpace {
+                normal: *normal,
+                height: *height,
+            }),
+            Self::Sphere { .. }
+            | Self::Box { .. }
+            | Self::RoundBox { .. }
+            | Self::Torus { .. }
+            | Self::CappedCylinder { .. }
+            | Self::Capsule { .. }
+            | Self::DeathStar { .. } => None,
+        }
+    }
+}
+
+impl From<Primitive> for Sdf {
+    fn from(shape: Primitive) -> Sdf {
+        Sdf::Primitive(shape)
+    }
+}
+
+/// The constructors of the primitive leaves.
+impl Sdf {
+    /// [`Primitive::Sphere`] of the given radius.
+    pub fn sphere(radius: f32) -> Self {
+        Primitive::Sphere { radius }.into()
+    }
+
+    /// [`Primitive::Box`] with the given half extents (`box` is a Rust keyword).
+    pub fn cuboid(half_extents: Vec3) -> Self {
+        Primitive::Box { half_extents }.into()
+    }
+
+    /// [`Primitive::RoundBox`]: outer half extents, edge radius.
+    pub fn round_box(half_extents: Vec3, radius: f32) -> Self {
+        Primitive::RoundBox {
+            half_extents,
+            radius,
+        }
+        .into()
+    }
+
+    /// [`Primitive::Plane`] with `normal` normalised here (a zero or non-finite normal
+    /// becomes +Y).
+    pub fn plane(normal: Vec3, height: f32) -> Self {
+        Primitive::Plane {
+            normal: normal.normalize_or(Vec3::Y),
+            height,
+        }
+        .into()
+    }
+
+    /// [`Primitive::Torus`] in the XZ plane.
+    pub fn torus(major_radius: f32, minor_radius: f32) -> Self {
+        Primitive::Torus {
+            major_radius,
+            minor_radius,
+        }
+        .into()
+    }
+
+    /// [`Primitive::CappedCylinder`] along Y.
+    pub fn capped_cylinder(radius: f32, half_height: f32) -> Self {
+        Primitive::CappedCylinder {
+            radius,
+            half_height,
+        }
+        .into()
+    }
+
+    /// [`Primitive::Capsule`] around the segment `ab`.
+    pub fn capsule(a: Vec3, b: Vec3, radius: f32) -> Self {
+        Primitive::Capsule { a, b, radius }.into()
+    }
+
+    /// [`Primitive::DeathStar`].
+    pub fn death_star(ra: f32, rb: f32, d: f32) -> Self {
+        Primitive::DeathStar { ra, rb, d }.into()
+    }
+}
+
 #[inline]
-pub(crate) fn sphere(p: Vec3, radius: f32) -> f32 {
+fn unit_length(v: Vec3) -> bool {
+    (v.length_squared() - 1.0).abs() <= 1e-4
+}
+
+#[inline]
+fn sphere(p: Vec3, radius: f32) -> f32 {
     p.length() - radius.max(0.0)
 }
 
 /// iq sdBox: the outside part is the distance to the nearest point of the box, the inside
 /// part the (negative) distance to the nearest face.
 #[inline]
-pub(crate) fn cuboid(p: Vec3, half_extents: Vec3) -> f32 {
+fn cuboid(p: Vec3, half_extents: Vec3) -> f32 {
     let q = p.abs() - half_extents.max(Vec3::ZERO);
     q.max(Vec3::ZERO).length() + q.max_element().min(0.0)
 }
@@ -22,35 +326,35 @@ pub(crate) fn cuboid(p: Vec3, half_extents: Vec3) -> f32 {
 /// `half_extents`. The radius is clamped to `[0, smallest half extent]`, past which the
 /// shrunk box would turn inside out.
 #[inline]
-pub(crate) fn round_box(p: Vec3, half_extents: Vec3, radius: f32) -> f32 {
+fn round_box(p: Vec3, half_extents: Vec3, radius: f32) -> f32 {
     let b = half_extents.max(Vec3::ZERO);
     let r = round_box_radius(b, radius);
     cuboid(p, b - Vec3::splat(r)) - r
 }
 
 #[inline]
-pub(crate) fn round_box_radius(half_extents: Vec3, radius: f32) -> f32 {
+fn round_box_radius(half_extents: Vec3, radius: f32) -> f32 {
     radius
         .max(0.0)
         .min(half_extents.max(Vec3::ZERO).min_element())
 }
 
 #[inline]
-pub(crate) fn plane(p: Vec3, normal: Vec3, height: f32) -> f32 {
+fn plane(p: Vec3, normal: Vec3, height: f32) -> f32 {
     p.dot(normal) - height
 }
 
 /// iq sdTorus: the distance to the core circle of radius `major` in the XZ plane, minus the
 /// tube radius.
 #[inline]
-pub(crate) fn torus(p: Vec3, major: f32, minor: f32) -> f32 {
+fn torus(p: Vec3, major: f32, minor: f32) -> f32 {
     let q = Vec2::new(Vec2::new(p.x, p.z).length() - major.max(0.0), p.y);
     q.length() - minor.max(0.0)
 }
 
 /// iq sdCappedCylinder: the 2D box distance in the (radial, height) half-plane.
 #[inline]
-pub(crate) fn capped_cylinder(p: Vec3, radius: f32, half_height: f32) -> f32 {
+fn capped_cylinder(p: Vec3, radius: f32, half_height: f32) -> f32 {
     let size = Vec2::new(radius, half_height).max(Vec2::ZERO);
     let d = Vec2::new(Vec2::new(p.x, p.z).length(), p.y).abs() - size;
     d.max_element().min(0.0) + d.max(Vec2::ZERO).length()
@@ -58,7 +362,7 @@ pub(crate) fn capped_cylinder(p: Vec3, radius: f32, half_height: f32) -> f32 {
 
 /// iq sdCapsule: distance to the segment `ab`, minus the radius.
 #[inline]
-pub(crate) fn capsule(p: Vec3, a: Vec3, b: Vec3, radius: f32) -> f32 {
+fn capsule(p: Vec3, a: Vec3, b: Vec3, radius: f32) -> f32 {
     let pa = p - a;
     let ba = b - a;
     let h = pa.dot(ba) / ba.length_squared();
@@ -69,7 +373,7 @@ pub(crate) fn capsule(p: Vec3, a: Vec3, b: Vec3, radius: f32) -> f32 {
 
 /// The three situations a Death Star can be in; `Rim` is the only one with a crater edge.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum DeathStarKind {
+enum DeathStarKind {
     /// The small sphere misses the big one, or is a cavity strictly inside it.
     NoRim,
     /// The small sphere swallows the big one: nothing is left.
@@ -79,7 +383,7 @@ pub(crate) enum DeathStarKind {
 }
 
 #[inline]
-pub(crate) fn death_star_kind(ra: f32, rb: f32, d: f32) -> DeathStarKind {
+fn death_star_kind(ra: f32, rb: f32, d: f32) -> DeathStarKind {
     let (ra, rb, d) = (ra.max(0.0), rb.max(0.0), d.abs());
     if d + ra <= rb {
         DeathStarKind::Empty
@@ -100,7 +404,7 @@ pub(crate) fn death_star_kind(ra: f32, rb: f32, d: f32) -> DeathStarKind {
 /// everywhere; iq's formula divides by `d` and assumes a rim, so those cases are handled
 /// first. When nothing is left the max is still positive everywhere, a valid bound.
 #[inline]
-pub(crate) fn death_star(p: Vec3, ra: f32, rb: f32, d: f32) -> f32 {
+fn death_star(p: Vec3, ra: f32, rb: f32, d: f32) -> f32 {
     let (ra, rb) = (ra.max(0.0), rb.max(0.0));
     // Mirror so the small sphere sits on +x.
     let (x, d) = if d < 0.0 { (-p.x, -d) } else { (p.x, d) };

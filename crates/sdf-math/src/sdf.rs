@@ -4,7 +4,7 @@ use glam::{Quat, Vec3};
 
 use crate::DistanceField;
 use crate::blend::{smooth_max, smooth_min};
-use crate::primitives::{self, DeathStarKind};
+use crate::primitives::Primitive;
 
 /// A signed distance function as a closed enum tree: evaluation is a `match`, never a
 /// virtual call, and never allocates.
@@ -16,70 +16,8 @@ use crate::primitives::{self, DeathStarKind};
 /// ([`Sdf::is_exact`]) or only a bound.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Sdf {
-    /// Sphere centred at the origin. Exact; L = 1.
-    Sphere {
-        /// Radius; negative is treated as 0 (a point).
-        radius: f32,
-    },
-    /// Axis-aligned box centred at the origin (iq sdBox). Exact; L = 1.
-    Box {
-        /// Half the side lengths; negative components are treated as 0.
-        half_extents: Vec3,
-    },
-    /// Box with rounded edges (iq sdRoundBox); the outer size is still `half_extents`.
-    /// Exact; L = 1.
-    RoundBox {
-        /// Half the side lengths of the outer box; negative components are treated as 0.
-        half_extents: Vec3,
-        /// Edge radius, clamped to `[0, smallest half extent]`.
-        radius: f32,
-    },
-    /// Half-space below a plane: `distance = dot(p, normal) - height`. Exact with L = 1
-    /// when `normal` is unit (as [`Sdf::plane`] makes it); otherwise L = `|normal|` (or 1
-    /// if smaller) and only a bound.
-    Plane {
-        /// Outward unit normal.
-        normal: Vec3,
-        /// Offset of the plane along `normal`.
-        height: f32,
-    },
-    /// Torus: a ring in the XZ plane around the Y axis (iq sdTorus). L = 1; exact unless
-    /// `minor_radius > major_radius` (a self-intersecting spindle torus), where it is exact
-    /// outside and a bound inside.
-    Torus {
-        /// Radius of the core circle; negative is treated as 0.
-        major_radius: f32,
-        /// Radius of the tube; negative is treated as 0.
-        minor_radius: f32,
-    },
-    /// Cylinder with flat caps, axis Y, centred at the origin (iq sdCappedCylinder).
-    /// Exact; L = 1.
-    CappedCylinder {
-        /// Radius; negative is treated as 0.
-        radius: f32,
-        /// Half the height; negative is treated as 0.
-        half_height: f32,
-    },
-    /// Points within `radius` of the segment `ab` (iq sdCapsule). Exact; L = 1.
-    Capsule {
-        /// One end of the core segment.
-        a: Vec3,
-        /// The other end of the core segment.
-        b: Vec3,
-        /// Radius; negative is treated as 0.
-        radius: f32,
-    },
-    /// Sphere of radius `ra` at the origin minus a sphere of radius `rb` at `(d, 0, 0)`
-    /// (iq sdDeathStar). Exact; L = 1. When the small sphere swallows the big one nothing
-    /// is left and the value is a positive bound instead.
-    DeathStar {
-        /// Radius of the kept sphere; negative is treated as 0.
-        ra: f32,
-        /// Radius of the carved sphere; negative is treated as 0.
-        rb: f32,
-        /// Offset of the carved sphere along x (either sign).
-        d: f32,
-    },
+    /// A primitive shape: see [`Primitive`] for each one's bound and exactness.
+    Primitive(Primitive),
     /// `min` of the children. L = max over children. Exact outside when the children are
     /// exact outside; inside, where children overlap, only a bound. Empty: `+inf` (nothing).
     Union(Vec<Sdf>),
@@ -143,58 +81,6 @@ pub enum Sdf {
 }
 
 impl Sdf {
-    /// [`Sdf::Sphere`] of the given radius.
-    pub fn sphere(radius: f32) -> Self {
-        Self::Sphere { radius }
-    }
-
-    /// [`Sdf::Box`] with the given half extents (`box` is a Rust keyword).
-    pub fn cuboid(half_extents: Vec3) -> Self {
-        Self::Box { half_extents }
-    }
-
-    /// [`Sdf::RoundBox`]: outer half extents, edge radius.
-    pub fn round_box(half_extents: Vec3, radius: f32) -> Self {
-        Self::RoundBox {
-            half_extents,
-            radius,
-        }
-    }
-
-    /// [`Sdf::Plane`] with `normal` normalised here (a zero or non-finite normal becomes +Y).
-    pub fn plane(normal: Vec3, height: f32) -> Self {
-        Self::Plane {
-            normal: normal.normalize_or(Vec3::Y),
-            height,
-        }
-    }
-
-    /// [`Sdf::Torus`] in the XZ plane.
-    pub fn torus(major_radius: f32, minor_radius: f32) -> Self {
-        Self::Torus {
-            major_radius,
-            minor_radius,
-        }
-    }
-
-    /// [`Sdf::CappedCylinder`] along Y.
-    pub fn capped_cylinder(radius: f32, half_height: f32) -> Self {
-        Self::CappedCylinder {
-            radius,
-            half_height,
-        }
-    }
-
-    /// [`Sdf::Capsule`] around the segment `ab`.
-    pub fn capsule(a: Vec3, b: Vec3, radius: f32) -> Self {
-        Self::Capsule { a, b, radius }
-    }
-
-    /// [`Sdf::DeathStar`].
-    pub fn death_star(ra: f32, rb: f32, d: f32) -> Self {
-        Self::DeathStar { ra, rb, d }
-    }
-
     /// [`Sdf::Union`].
     pub fn union(children: Vec<Sdf>) -> Self {
         Self::Union(children)
@@ -259,23 +145,7 @@ impl Sdf {
     /// Signed distance (or bound, see the variant) at `p`; negative inside.
     pub fn distance(&self, p: Vec3) -> f32 {
         match self {
-            Self::Sphere { radius } => primitives::sphere(p, *radius),
-            Self::Box { half_extents } => primitives::cuboid(p, *half_extents),
-            Self::RoundBox {
-                half_extents,
-                radius,
-            } => primitives::round_box(p, *half_extents, *radius),
-            Self::Plane { normal, height } => primitives::plane(p, *normal, *height),
-            Self::Torus {
-                major_radius,
-                minor_radius,
-            } => primitives::torus(p, *major_radius, *minor_radius),
-            Self::CappedCylinder {
-                radius,
-                half_height,
-            } => primitives::capped_cylinder(p, *radius, *half_height),
-            Self::Capsule { a, b, radius } => primitives::capsule(p, *a, *b, *radius),
-            Self::DeathStar { ra, rb, d } => primitives::death_star(p, *ra, *rb, *d),
+            Self::Primitive(shape) => shape.distance(p),
             Self::Union(children) => children
                 .iter()
                 .fold(f32::INFINITY, |m, c| m.min(c.distance(p))),
@@ -318,21 +188,12 @@ impl Sdf {
         }
     }
 
-    /// Lipschitz bound L of [`Sdf::distance`]: 1 for every primitive (`|normal|` for a
-    /// plane with a longer than unit normal), the maximum over children for every CSG and
-    /// smooth operator, and the child's for every transform. See the variants for why.
+    /// Lipschitz bound L of [`Sdf::distance`]: the primitive's ([`Primitive::lipschitz`]),
+    /// the maximum over children for every CSG and smooth operator, and the child's for
+    /// every transform. See the variants for why.
     pub fn lipschitz(&self) -> f32 {
         match self {
-            Self::Sphere { .. }
-            | Self::Box { .. }
-            | Self::RoundBox { .. }
-            | Self::Torus { .. }
-            | Self::CappedCylinder { .. }
-            | Self::Capsule { .. }
-            | Self::DeathStar { .. } => 1.0,
-            // NaN.max(1.0) is 1.0, but a NaN normal makes NaN distances, which the tracer
-            // reports as GaveUp anyway.
-            Self::Plane { normal, .. } => normal.length().max(1.0),
+            Self::Primitive(shape) => shape.lipschitz(),
             Self::Union(children)
             | Self::Intersection(children)
             | Self::Difference(children)
@@ -348,24 +209,12 @@ impl Sdf {
     }
 
     /// True where [`Sdf::distance`] is the exact signed Euclidean distance to the surface
-    /// everywhere, inside and out: the primitives (see the torus and Death Star caveats),
-    /// one-child CSG nodes of exact children, and transforms of exact shapes. CSG of two or
+    /// everywhere, inside and out: the exact primitives ([`Primitive::is_exact`]), one-child
+    /// CSG nodes of exact children, and transforms of exact shapes. CSG of two or
     /// more shapes is never claimed exact; see [`Sdf::is_exact_outside`].
     pub fn is_exact(&self) -> bool {
         match self {
-            Self::Sphere { .. }
-            | Self::Box { .. }
-            | Self::RoundBox { .. }
-            | Self::CappedCylinder { .. }
-            | Self::Capsule { .. } => true,
-            Self::Plane { normal, .. } => unit_length(*normal),
-            Self::Torus {
-                major_radius,
-                minor_radius,
-            } => major_radius.max(0.0) >= minor_radius.max(0.0),
-            Self::DeathStar { ra, rb, d } => {
-                primitives::death_star_kind(*ra, *rb, *d) != DeathStarKind::Empty
-            }
+            Self::Primitive(shape) => shape.is_exact(),
             Self::Union(children)
             | Self::Intersection(children)
             | Self::Difference(children)
@@ -382,11 +231,11 @@ impl Sdf {
 
     /// True where [`Sdf::distance`] is exact at every point outside the shape (positive
     /// values), which is where a tracer marches: everything [`Sdf::is_exact`] accepts, the
-    /// spindle torus, and unions of shapes exact outside (the distance to a union is the
+    /// primitives exact outside ([`Primitive::is_exact_outside`]: the spindle torus), and unions of shapes exact outside (the distance to a union is the
     /// minimum of the distances).
     pub fn is_exact_outside(&self) -> bool {
         match self {
-            Self::Torus { .. } => true,
+            Self::Primitive(shape) => shape.is_exact_outside(),
             Self::Union(children) => children.iter().all(Self::is_exact_outside),
             Self::Intersection(children)
             | Self::Difference(children)
@@ -398,7 +247,6 @@ impl Sdf {
             },
             Self::Translate { child, .. } | Self::Rotate { child, .. } => child.is_exact_outside(),
             Self::Scale { factor, child } => usable_factor(*factor) && child.is_exact_outside(),
-            _ => self.is_exact(),
         }
     }
 }
@@ -436,11 +284,6 @@ pub(crate) fn rotate(q: Quat, v: Vec3) -> Vec3 {
 #[inline]
 pub(crate) fn usable_factor(factor: f32) -> bool {
     factor.abs() >= f32::MIN_POSITIVE && factor.is_finite()
-}
-
-#[inline]
-fn unit_length(v: Vec3) -> bool {
-    (v.length_squared() - 1.0).abs() <= 1e-4
 }
 
 #[cfg(test)]
@@ -515,10 +358,10 @@ mod tests {
         assert!(!Sdf::death_star(0.5, 1.0, 0.1).is_exact());
         assert!(Sdf::death_star(1.0, 0.5, 0.8).is_exact());
         assert!(
-            !Sdf::Plane {
+            !Sdf::from(Primitive::Plane {
                 normal: Vec3::ONE,
                 height: 0.0
-            }
+            })
             .is_exact()
         );
         assert!(!Sdf::sphere(1.0).scale(0.0).is_exact());
@@ -529,10 +372,10 @@ mod tests {
     fn lipschitz_per_node() {
         let s = Sdf::sphere(1.0);
         assert_eq!(s.lipschitz(), 1.0);
-        let steep = Sdf::Plane {
+        let steep = Sdf::from(Primitive::Plane {
             normal: Vec3::new(0.0, 3.0, 4.0),
             height: 0.0,
-        };
+        });
         assert_eq!(steep.lipschitz(), 5.0);
         assert_eq!(
             Sdf::smooth_union(0.1, vec![s, steep])

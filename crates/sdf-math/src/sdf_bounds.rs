@@ -26,28 +26,7 @@ impl Sdf {
     fn bounding_sphere_unchecked(&self) -> Option<(Vec3, f32)> {
         const NOTHING: Option<(Vec3, f32)> = Some((Vec3::ZERO, 0.0));
         match self {
-            Self::Sphere { radius } => Some((Vec3::ZERO, radius.max(0.0))),
-            Self::Box { half_extents } | Self::RoundBox { half_extents, .. } => {
-                Some((Vec3::ZERO, half_extents.max(Vec3::ZERO).length()))
-            }
-            Self::Plane { .. } => None,
-            Self::Torus {
-                major_radius,
-                minor_radius,
-            } => Some((Vec3::ZERO, major_radius.max(0.0) + minor_radius.max(0.0))),
-            Self::CappedCylinder {
-                radius,
-                half_height,
-            } => Some((
-                Vec3::ZERO,
-                glam::Vec2::new(*radius, *half_height)
-                    .max(glam::Vec2::ZERO)
-                    .length(),
-            )),
-            Self::Capsule { a, b, radius } => {
-                Some(((*a + *b) * 0.5, (*b - *a).length() * 0.5 + radius.max(0.0)))
-            }
-            Self::DeathStar { ra, .. } => Some((Vec3::ZERO, ra.max(0.0))),
+            Self::Primitive(shape) => shape.bounding_sphere(),
             Self::Union(children) => merge_all(children),
             Self::SmoothUnion { k, children } => {
                 let (centre, radius) = merge_all(children)?;
@@ -106,34 +85,8 @@ impl Sdf {
             min: Vec3::ZERO,
             max: Vec3::ZERO,
         });
-        let centered = |half: Vec3| Some(Aabb::from_center(Vec3::ZERO, half.max(Vec3::ZERO)));
         match self {
-            Self::Sphere { radius } => centered(Vec3::splat(*radius)),
-            Self::Box { half_extents } | Self::RoundBox { half_extents, .. } => {
-                centered(*half_extents)
-            }
-            Self::Plane { .. } => None,
-            Self::Torus {
-                major_radius,
-                minor_radius,
-            } => {
-                let (big, small) = (major_radius.max(0.0), minor_radius.max(0.0));
-                centered(Vec3::new(big + small, small, big + small))
-            }
-            Self::CappedCylinder {
-                radius,
-                half_height,
-            } => centered(Vec3::new(*radius, *half_height, *radius)),
-            Self::Capsule { a, b, radius } => {
-                let r = Vec3::splat(radius.max(0.0));
-                Some(Aabb {
-                    min: a.min(*b) - r,
-                    max: a.max(*b) + r,
-                })
-            }
-            // The field is at least the distance to the kept sphere (the rim circle lies
-            // on it), so that sphere's box will do.
-            Self::DeathStar { ra, .. } => centered(Vec3::splat(*ra)),
+            Self::Primitive(shape) => shape.bounding_box(),
             Self::Union(children) => union_boxes(children),
             Self::SmoothUnion { k, children } => {
                 let merged = union_boxes(children)?;
@@ -211,11 +164,7 @@ impl Sdf {
 
     fn bounding_half_space_unchecked(&self) -> Option<HalfSpace> {
         match self {
-            // Equality: the field is that linear function.
-            Self::Plane { normal, height } => Some(HalfSpace {
-                normal: *normal,
-                height: *height,
-            }),
+            Self::Primitive(shape) => shape.bounding_half_space(),
             Self::Intersection(children) | Self::SmoothIntersection { children, .. } => {
                 children.iter().find_map(Self::bounding_half_space)
             }
@@ -244,7 +193,9 @@ impl Sdf {
                     height: h.height * factor.abs(),
                 })
             }
-            _ => None,
+            // A union reaches wherever any of its children does, so no one child's
+            // half-space holds it; a collapsed scale is nothing and needs none.
+            Self::Union(_) | Self::SmoothUnion { .. } | Self::Scale { .. } => None,
         }
     }
 }

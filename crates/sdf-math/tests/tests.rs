@@ -4,8 +4,8 @@
 //! on every machine.
 
 use lueur_sdf_math::{
-    DistanceField, Quat, Ray, Sdf, TraceOutcome, TraceParams, Vec3, normal, normal_central,
-    sphere_trace,
+    DistanceField, Primitive, Quat, Ray, Sdf, TraceOutcome, TraceParams, Vec3, normal,
+    normal_central, sphere_trace,
 };
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
@@ -67,19 +67,21 @@ mod strategies {
         DeathStar,
     );
 
-    /// The kind of a primitive node, `None` for combinations and transforms. The match
-    /// has no wildcard: a new `Sdf` variant does not compile until it is given a kind
-    /// here, and with it a conformance run.
+    /// The kind of a primitive node, `None` for combinations and transforms. The matches
+    /// have no wildcard: a new `Primitive` (or `Sdf`) variant does not compile until it is
+    /// given a kind here, and with it a conformance run.
     pub fn kind_of(sdf: &Sdf) -> Option<Kind> {
         match sdf {
-            Sdf::Sphere { .. } => Some(Kind::Sphere),
-            Sdf::Box { .. } => Some(Kind::Box),
-            Sdf::RoundBox { .. } => Some(Kind::RoundBox),
-            Sdf::Plane { .. } => Some(Kind::Plane),
-            Sdf::Torus { .. } => Some(Kind::Torus),
-            Sdf::CappedCylinder { .. } => Some(Kind::CappedCylinder),
-            Sdf::Capsule { .. } => Some(Kind::Capsule),
-            Sdf::DeathStar { .. } => Some(Kind::DeathStar),
+            Sdf::Primitive(shape) => Some(match shape {
+                Primitive::Sphere { .. } => Kind::Sphere,
+                Primitive::Box { .. } => Kind::Box,
+                Primitive::RoundBox { .. } => Kind::RoundBox,
+                Primitive::Plane { .. } => Kind::Plane,
+                Primitive::Torus { .. } => Kind::Torus,
+                Primitive::CappedCylinder { .. } => Kind::CappedCylinder,
+                Primitive::Capsule { .. } => Kind::Capsule,
+                Primitive::DeathStar { .. } => Kind::DeathStar,
+            }),
             Sdf::Union { .. }
             | Sdf::Intersection { .. }
             | Sdf::Difference { .. }
@@ -131,28 +133,30 @@ mod strategies {
 
     /// A unit primitive scaled by `size` (by editing its parameters, not with `Scale`).
     pub fn sized(shape: Sdf, size: f32) -> Sdf {
+        let Sdf::Primitive(shape) = shape else {
+            return shape;
+        };
         match shape {
-            Sdf::Sphere { radius } => Sdf::sphere(radius * size),
-            Sdf::Box { half_extents } => Sdf::cuboid(half_extents * size),
-            Sdf::RoundBox {
+            Primitive::Sphere { radius } => Sdf::sphere(radius * size),
+            Primitive::Box { half_extents } => Sdf::cuboid(half_extents * size),
+            Primitive::RoundBox {
                 half_extents,
                 radius,
             } => Sdf::round_box(half_extents * size, radius * size),
-            Sdf::Plane { normal, height } => Sdf::Plane {
+            Primitive::Plane { normal, height } => Sdf::from(Primitive::Plane {
                 normal,
                 height: height * size,
-            },
-            Sdf::Torus {
+            }),
+            Primitive::Torus {
                 major_radius,
                 minor_radius,
             } => Sdf::torus(major_radius * size, minor_radius * size),
-            Sdf::CappedCylinder {
+            Primitive::CappedCylinder {
                 radius,
                 half_height,
             } => Sdf::capped_cylinder(radius * size, half_height * size),
-            Sdf::Capsule { a, b, radius } => Sdf::capsule(a * size, b * size, radius * size),
-            Sdf::DeathStar { ra, rb, d } => Sdf::death_star(ra * size, rb * size, d * size),
-            other => other,
+            Primitive::Capsule { a, b, radius } => Sdf::capsule(a * size, b * size, radius * size),
+            Primitive::DeathStar { ra, rb, d } => Sdf::death_star(ra * size, rb * size, d * size),
         }
     }
 
@@ -503,8 +507,11 @@ mod exact {
 
     /// Brute-force signed distance and the sampling error it may carry.
     fn brute(sdf: &Sdf, p: Vec3) -> (f64, f64) {
-        match *sdf {
-            Sdf::Sphere { radius } => {
+        let Sdf::Primitive(shape) = *sdf else {
+            unreachable!("not a primitive: {sdf:?}")
+        };
+        match shape {
+            Primitive::Sphere { radius } => {
                 let r = radius as f64;
                 let d = sampled(profile_y(p), N, |u| {
                     Some([r * (PI * u).sin(), r * (PI * u).cos()])
@@ -512,8 +519,8 @@ mod exact {
                 let inside = (p.as_dvec3().length()) < r;
                 (if inside { -d } else { d }, PI * r / N as f64)
             }
-            Sdf::Box { half_extents } => (box_by_faces(p, half_extents), 0.0),
-            Sdf::RoundBox {
+            Primitive::Box { half_extents } => (box_by_faces(p, half_extents), 0.0),
+            Primitive::RoundBox {
                 half_extents,
                 radius,
             } => {
@@ -523,7 +530,7 @@ mod exact {
                 let inner = half_extents - Vec3::splat(r as f32);
                 (box_by_faces(p, inner) - r, 0.0)
             }
-            Sdf::Torus {
+            Primitive::Torus {
                 major_radius,
                 minor_radius,
             } => {
@@ -538,7 +545,7 @@ mod exact {
                 let inside = hypot(q[0] - big, q[1]) < small;
                 (if inside { -d } else { d }, PI * small / N as f64)
             }
-            Sdf::CappedCylinder {
+            Primitive::CappedCylinder {
                 radius,
                 half_height,
             } => {
@@ -554,14 +561,14 @@ mod exact {
                 let inside = q[0] < r && q[1].abs() < h;
                 (if inside { -d } else { d }, (r + 2.0 * h) / N as f64)
             }
-            Sdf::Capsule { a, b, radius } => {
+            Primitive::Capsule { a, b, radius } => {
                 let (p, a, b) = (p.as_dvec3(), a.as_dvec3(), b.as_dvec3());
                 let core = (0..=N)
                     .map(|i| (p - a.lerp(b, i as f64 / N as f64)).length())
                     .fold(f64::INFINITY, f64::min);
                 (core - radius as f64, (b - a).length() / N as f64)
             }
-            Sdf::DeathStar { ra, rb, d } => {
+            Primitive::DeathStar { ra, rb, d } => {
                 let (ra, rb, d) = (ra as f64, rb as f64, d as f64);
                 let q = profile_x(p);
                 // The big sphere's part outside the small one, then the small sphere's part
@@ -630,15 +637,18 @@ mod exact {
     fn on_surface(sdf: &Sdf, u: f32, v: f32, dir: Vec3) -> Option<Vec3> {
         use std::f32::consts::TAU;
         let ring = |r: f32, y: f32| Vec3::new(r * (TAU * u).cos(), y, r * (TAU * u).sin());
-        Some(match *sdf {
-            Sdf::Sphere { radius } => dir * radius,
-            Sdf::Box { half_extents: b }
-            | Sdf::RoundBox {
+        let Sdf::Primitive(shape) = *sdf else {
+            unreachable!("not a primitive: {sdf:?}")
+        };
+        Some(match shape {
+            Primitive::Sphere { radius } => dir * radius,
+            Primitive::Box { half_extents: b }
+            | Primitive::RoundBox {
                 half_extents: b,
                 radius: _,
             } => {
-                let r = match *sdf {
-                    Sdf::RoundBox { radius, .. } => radius,
+                let r = match shape {
+                    Primitive::RoundBox { radius, .. } => radius,
                     _ => 0.0,
                 };
                 // Nearest point of the inner box to a far point, pushed out by r.
@@ -647,7 +657,7 @@ mod exact {
                 let c = far.clamp(-inner, inner);
                 c + (far - c).normalize() * r
             }
-            Sdf::Torus {
+            Primitive::Torus {
                 major_radius,
                 minor_radius,
             } => {
@@ -657,7 +667,7 @@ mod exact {
                     minor_radius * a.sin(),
                 )
             }
-            Sdf::CappedCylinder {
+            Primitive::CappedCylinder {
                 radius,
                 half_height,
             } => match (v * 3.0) as u32 {
@@ -665,7 +675,7 @@ mod exact {
                 1 => ring(radius * u.sqrt(), -half_height),
                 _ => ring(radius, half_height * (2.0 * (v * 3.0).fract() - 1.0)),
             },
-            Sdf::Capsule { a, b, radius } => {
+            Primitive::Capsule { a, b, radius } => {
                 let axis = (b - a).normalize_or(Vec3::Y);
                 let side = (dir - axis * dir.dot(axis)).normalize_or(axis.any_orthonormal_vector());
                 match (v * 3.0) as u32 {
@@ -674,7 +684,7 @@ mod exact {
                     _ => a.lerp(b, u) + side * radius,
                 }
             }
-            Sdf::DeathStar { ra, rb, d } => {
+            Primitive::DeathStar { ra, rb, d } => {
                 let small = Vec3::new(d, 0.0, 0.0);
                 let big_point = dir * ra;
                 let small_point = small + dir * rb;
@@ -1022,7 +1032,8 @@ mod robustness {
             f.clone().prop_map(Sdf::sphere),
             v.clone().prop_map(Sdf::cuboid),
             (v.clone(), f.clone()).prop_map(|(b, r)| Sdf::round_box(b, r)),
-            (v.clone(), f.clone()).prop_map(|(normal, height)| Sdf::Plane { normal, height }),
+            (v.clone(), f.clone())
+                .prop_map(|(normal, height)| Sdf::from(Primitive::Plane { normal, height })),
             (f.clone(), f.clone()).prop_map(|(a, b)| Sdf::torus(a, b)),
             (f.clone(), f.clone()).prop_map(|(a, b)| Sdf::capped_cylinder(a, b)),
             (v.clone(), v.clone(), f.clone()).prop_map(|(a, b, r)| Sdf::capsule(a, b, r)),
