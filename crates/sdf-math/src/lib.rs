@@ -49,6 +49,7 @@
 mod blend;
 mod bound;
 mod field;
+mod lanes;
 mod normal;
 mod prepared;
 mod primitives;
@@ -62,6 +63,10 @@ pub use glam::{Quat, Vec3};
 pub use crate::blend::{smooth_max, smooth_min};
 pub use crate::bound::{Aabb, HalfSpace, RayClip};
 pub use crate::field::DistanceField;
+pub use crate::lanes::{
+    Avx2, Avx512, Isa, Lane, LaneDistance, LaneKernel, LaneVec3, Neon, Portable, SimdLevel, Sse,
+    Task, UnavailableLevel, Wide,
+};
 pub use crate::normal::{FALLBACK_NORMAL, gradient, gradient_central, normal, normal_central};
 pub use crate::prepared::PreparedSdf;
 pub use crate::primitives::Primitive;

@@ -1,0 +1,202 @@
+//! The number type the distance formulas are written over: [`Lane`] is `f32` for the
+//! scalar tracer and [`Wide`] (N `f32` lanes under one instruction set) for a SIMD
+//! tracer, so that each primitive and operator has one definition that both evaluate.
+//!
+//! The contract every implementation meets: **each lane's result is, bit for bit, what
+//! `f32` gives for that lane's inputs**. That is why the trait has two kinds of minimum
+//! and maximum (Rust's NaN-ignoring [`f32::min`] and glam's comparison, which the vector
+//! methods use), each written as one comparison and select on every side, and why there is
+//! no fused multiply-add: with only IEEE add, subtract, multiply, divide and square root,
+//! and the same order of operations, a vector unit rounds exactly as the scalar one does.
+
+mod dispatch;
+mod vec;
+mod wide;
+
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+pub use dispatch::{LaneDistance, LaneKernel, SimdLevel, UnavailableLevel};
+pub(crate) use vec::LaneVec2;
+pub use vec::LaneVec3;
+pub use wide::{Avx2, Avx512, Isa, Neon, Portable, Sse, Wide};
+
+/// A number type with `LANES` independent `f32` lanes: `f32` itself, or a [`Wide`] vector.
+///
+/// Contract: every operation acts on each lane alone and gives, bit for bit, what the
+/// `f32` implementation gives for that lane (see the module notes).
+pub trait Lane:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// One boolean per lane.
+    type Mask: Copy;
+    /// How many `f32` lanes a value holds.
+    const LANES: usize;
+
+    /// Every lane set to `value`.
+    fn splat(value: f32) -> Self;
+    /// The first `values.len()` lanes from `values` (at most [`Lane::LANES`]), the rest 0.
+    fn load(values: &[f32]) -> Self;
+    /// The first `out.len()` lanes (at most [`Lane::LANES`]) into `out`.
+    fn store(self, out: &mut [f32]);
+
+    /// Square root, correctly rounded.
+    fn sqrt(self) -> Self;
+    /// Absolute value (clears the sign bit).
+    fn abs(self) -> Self;
+    /// [`f32::min`]: the other operand where one is NaN.
+    fn min(self, other: Self) -> Self;
+    /// [`f32::max`]: the other operand where one is NaN.
+    fn max(self, other: Self) -> Self;
+    /// glam's minimum, `if self < other { self } else { other }` (a NaN `self` loses).
+    fn min_cmp(self, other: Self) -> Self;
+    /// glam's maximum, `if self > other { self } else { other }` (a NaN `self` loses).
+    fn max_cmp(self, other: Self) -> Self;
+    /// [`f32::clamp`] to `[lo, hi]` (NaN stays NaN).
+    fn clamp(self, lo: f32, hi: f32) -> Self;
+
+    /// `self < other`, per lane.
+    fn lt(self, other: Self) -> Self::Mask;
+    /// `self > other`, per lane.
+    fn gt(self, other: Self) -> Self::Mask;
+    /// `self.is_nan()`, per lane.
+    fn is_nan(self) -> Self::Mask;
+    /// `if mask { if_true } else { if_false }`, per lane.
+    fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
+}
+
+/// Work handed to [`Isa::within`]: a struct, not a closure, because
+/// its `run` must be `#[inline(always)]` to be compiled with the instruction set it is
+/// run under (a closure body is a function of its own, compiled for the target's
+/// baseline unless the inliner happens to take it).
+pub trait Task {
+    /// What the work returns.
+    type Output;
+    /// Does the work; implement it `#[inline(always)]`.
+    fn run(self) -> Self::Output;
+}
+
+/// The scalar lane: exactly the `f32` operations the formulas were written with.
+impl Lane for f32 {
+    type Mask = bool;
+    const LANES: usize = 1;
+
+    #[inline(always)]
+    fn splat(value: f32) -> f32 {
+        value
+    }
+
+    #[inline(always)]
+    fn load(values: &[f32]) -> f32 {
+        values.first().copied().unwrap_or(0.0)
+    }
+
+    #[inline(always)]
+    fn store(self, out: &mut [f32]) {
+        if let Some(slot) = out.first_mut() {
+            *slot = self;
+        }
+    }
+
+    #[inline(always)]
+    fn sqrt(self) -> f32 {
+        f32::sqrt(self)
+    }
+
+    #[inline(always)]
+    fn abs(self) -> f32 {
+        f32::abs(self)
+    }
+
+    // `f32::min` leaves the sign of a zero tie to the backend (x86 answers differently for
+    // scalars and vectors depending on what it can prove), so it is spelled out as the
+    // select x86 lowers `minnum(a, b)` to: `b` if `a` is NaN, else `b < a ? b : a`.
+    #[inline(always)]
+    fn min(self, other: f32) -> f32 {
+        if self.is_nan() || other < self {
+            other
+        } else {
+            self
+        }
+    }
+
+    #[inline(always)]
+    fn max(self, other: f32) -> f32 {
+        if self.is_nan() || other > self {
+            other
+        } else {
+            self
+        }
+    }
+
+    #[inline(always)]
+    fn min_cmp(self, other: f32) -> f32 {
+        if self < other { self } else { other }
+    }
+
+    #[inline(always)]
+    fn max_cmp(self, other: f32) -> f32 {
+        if self > other { self } else { other }
+    }
+
+    #[inline(always)]
+    fn clamp(self, lo: f32, hi: f32) -> f32 {
+        let x = if self < lo { lo } else { self };
+        if x > hi { hi } else { x }
+    }
+
+    #[inline(always)]
+    fn lt(self, other: f32) -> bool {
+        self < other
+    }
+
+    #[inline(always)]
+    fn gt(self, other: f32) -> bool {
+        self > other
+    }
+
+    #[inline(always)]
+    fn is_nan(self) -> bool {
+        f32::is_nan(self)
+    }
+
+    #[inline(always)]
+    fn select(mask: bool, if_true: f32, if_false: f32) -> f32 {
+        if mask { if_true } else { if_false }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The spelled-out minimum and maximum are Rust's wherever Rust's is specified.
+    #[test]
+    fn min_and_max_follow_f32() {
+        let values = [
+            -2.0,
+            -0.5,
+            0.5,
+            3.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        for a in values {
+            for b in values {
+                let same =
+                    |x: f32, y: f32| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan());
+                assert!(same(Lane::min(a, b), a.min(b)), "min({a}, {b})");
+                assert!(same(Lane::max(a, b), a.max(b)), "max({a}, {b})");
+                assert!(
+                    same(Lane::clamp(a, 0.0, 1.0), a.clamp(0.0, 1.0)),
+                    "clamp({a})"
+                );
+            }
+        }
+    }
+}
