@@ -1,5 +1,7 @@
 //! Smooth minimum and maximum: the blend behind the smooth CSG operators.
 
+use crate::lanes::Lane;
+
 /// Quadratic polynomial smooth minimum (iq, "smin", the normalised form with `k *= 4`).
 ///
 /// `k` is the largest amount by which the result undercuts `min(a, b)`, reached where
@@ -12,21 +14,34 @@
 /// max(|a - a'|, |b - b'|)`: blending L1- and L2-Lipschitz fields is max(L1, L2)-Lipschitz.
 #[inline]
 pub fn smooth_min(a: f32, b: f32, k: f32) -> f32 {
-    // Written so that NaN takes the hard-min path too.
-    if k.is_nan() || k <= 0.0 {
-        return a.min(b);
-    }
-    let band = 4.0 * k;
-    // h in [0, 1]; the product h * h * k cannot overflow even for huge k.
-    let h = (band - (a - b).abs()).max(0.0) / band;
-    a.min(b) - h * h * k
+    smooth_min_lanes(a, b, k)
 }
 
 /// Smooth maximum, `-smooth_min(-a, -b, k)`: overshoots `max(a, b)` by at most `k`, with
 /// the same Lipschitz argument as [`smooth_min`].
 #[inline]
 pub fn smooth_max(a: f32, b: f32, k: f32) -> f32 {
-    -smooth_min(-a, -b, k)
+    smooth_max_lanes(a, b, k)
+}
+
+/// [`smooth_min`] over any [`Lane`] type, its one definition; the blend size is the same
+/// in every lane.
+#[inline(always)]
+pub(crate) fn smooth_min_lanes<L: Lane>(a: L, b: L, k: f32) -> L {
+    // Written so that NaN takes the hard-min path too.
+    if k.is_nan() || k <= 0.0 {
+        return a.min(b);
+    }
+    let band = 4.0 * k;
+    // h in [0, 1]; the product h * h * k cannot overflow even for huge k.
+    let h = (L::splat(band) - (a - b).abs()).max(L::splat(0.0)) / L::splat(band);
+    a.min(b) - h * h * L::splat(k)
+}
+
+/// [`smooth_max`] over any [`Lane`] type.
+#[inline(always)]
+pub(crate) fn smooth_max_lanes<L: Lane>(a: L, b: L, k: f32) -> L {
+    -smooth_min_lanes(-a, -b, k)
 }
 
 #[cfg(test)]

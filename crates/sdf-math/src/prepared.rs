@@ -3,6 +3,7 @@
 
 use glam::{Affine3A, Mat3A, Quat, Vec3, Vec3A};
 
+use crate::lanes::{Lane, LaneDistance, LaneVec3};
 use crate::{DistanceField, Sdf};
 
 /// [`Sdf`] with the transforms above its first non-transform node folded into one affine
@@ -76,7 +77,7 @@ impl PreparedSdf {
     /// at `|p|`.
     #[inline]
     pub fn evaluation_scale(&self, p: Vec3) -> f32 {
-        let local = self.to_local.transform_point3a(Vec3A::from(p));
+        let local = Vec3A::from(Vec3::from(self.local(LaneVec3::from(p))));
         let own = self.factor * local.abs().max_element();
         if self.to_local.matrix3 == Mat3A::IDENTITY {
             own
@@ -86,11 +87,39 @@ impl PreparedSdf {
     }
 }
 
+impl PreparedSdf {
+    /// `p` in the shape's frame: glam's `Affine3A::transform_point3a` written out in its
+    /// order, `((X p.x + Y p.y) + Z p.z) + T` with the matrix's columns `X`, `Y`, `Z`.
+    #[inline(always)]
+    fn local<L: Lane>(&self, p: LaneVec3<L>) -> LaneVec3<L> {
+        let m = &self.to_local.matrix3;
+        let t = self.to_local.translation;
+        LaneVec3::new(
+            affine_coordinate(p, Vec3::new(m.x_axis.x, m.y_axis.x, m.z_axis.x), t.x),
+            affine_coordinate(p, Vec3::new(m.x_axis.y, m.y_axis.y, m.z_axis.y), t.y),
+            affine_coordinate(p, Vec3::new(m.x_axis.z, m.y_axis.z, m.z_axis.z), t.z),
+        )
+    }
+}
+
+/// One coordinate of the affine map: `((row.x p.x + row.y p.y) + row.z p.z) + t`.
+#[inline(always)]
+fn affine_coordinate<L: Lane>(p: LaneVec3<L>, row: Vec3, t: f32) -> L {
+    L::splat(row.x) * p.x + L::splat(row.y) * p.y + L::splat(row.z) * p.z + L::splat(t)
+}
+
+/// The one definition of the prepared field: the affine map, the tree, the factor.
+impl LaneDistance for PreparedSdf {
+    #[inline]
+    fn distance_lanes<L: Lane>(&self, p: LaneVec3<L>) -> L {
+        L::splat(self.factor) * self.shape.distance_lanes(self.local(p))
+    }
+}
+
 impl DistanceField for PreparedSdf {
     #[inline]
     fn distance(&self, p: Vec3) -> f32 {
-        let local = self.to_local.transform_point3a(Vec3A::from(p));
-        self.factor * self.shape.distance(local.into())
+        self.distance_lanes(LaneVec3::from(p))
     }
 
     #[inline]

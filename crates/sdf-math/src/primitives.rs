@@ -13,6 +13,7 @@ use glam::{Vec2, Vec3};
 
 use crate::Sdf;
 use crate::bound::{Aabb, HalfSpace};
+use crate::lanes::{Lane, LaneDistance, LaneVec2, LaneVec3};
 
 /// A primitive shape in its own frame, the leaves of the [`Sdf`] tree
 /// ([`Sdf::Primitive`]); move, turn or scale it with the tree's transforms.
@@ -88,28 +89,11 @@ pub enum Primitive {
 }
 
 impl Primitive {
-    /// Signed distance (or bound, see the variant) at `p`; negative inside.
+    /// Signed distance (or bound, see the variant) at `p`; negative inside: the
+    /// [`LaneDistance`] formula at `f32`.
     #[inline]
     pub fn distance(&self, p: Vec3) -> f32 {
-        match *self {
-            Self::Sphere { radius } => sphere(p, radius),
-            Self::Box { half_extents } => cuboid(p, half_extents),
-            Self::RoundBox {
-                half_extents,
-                radius,
-            } => round_box(p, half_extents, radius),
-            Self::Plane { normal, height } => plane(p, normal, height),
-            Self::Torus {
-                major_radius,
-                minor_radius,
-            } => torus(p, major_radius, minor_radius),
-            Self::CappedCylinder {
-                radius,
-                half_height,
-            } => capped_cylinder(p, radius, half_height),
-            Self::Capsule { a, b, radius } => capsule(p, a, b, radius),
-            Self::DeathStar { ra, rb, d } => death_star(p, ra, rb, d),
-        }
+        self.distance_lanes(LaneVec3::from(p))
     }
 
     /// Lipschitz bound L of [`Primitive::distance`]: 1, or `|normal|` for a plane with a
@@ -238,6 +222,33 @@ impl Primitive {
     }
 }
 
+/// The one definition of each primitive's distance. Parameters are prepared in `f32`
+/// (once per call, the same in every lane); only what depends on the point is lanes.
+impl LaneDistance for Primitive {
+    #[inline(always)]
+    fn distance_lanes<L: Lane>(&self, p: LaneVec3<L>) -> L {
+        match *self {
+            Self::Sphere { radius } => sphere(p, radius),
+            Self::Box { half_extents } => cuboid(p, half_extents),
+            Self::RoundBox {
+                half_extents,
+                radius,
+            } => round_box(p, half_extents, radius),
+            Self::Plane { normal, height } => plane(p, normal, height),
+            Self::Torus {
+                major_radius,
+                minor_radius,
+            } => torus(p, major_radius, minor_radius),
+            Self::CappedCylinder {
+                radius,
+                half_height,
+            } => capped_cylinder(p, radius, half_height),
+            Self::Capsule { a, b, radius } => capsule(p, a, b, radius),
+            Self::DeathStar { ra, rb, d } => death_star(p, ra, rb, d),
+        }
+    }
+}
+
 impl From<Primitive> for Sdf {
     fn from(shape: Primitive) -> Sdf {
         Sdf::Primitive(shape)
@@ -309,27 +320,27 @@ fn unit_length(v: Vec3) -> bool {
     (v.length_squared() - 1.0).abs() <= 1e-4
 }
 
-#[inline]
-fn sphere(p: Vec3, radius: f32) -> f32 {
-    p.length() - radius.max(0.0)
+#[inline(always)]
+fn sphere<L: Lane>(p: LaneVec3<L>, radius: f32) -> L {
+    p.length() - L::splat(radius.max(0.0))
 }
 
 /// iq sdBox: the outside part is the distance to the nearest point of the box, the inside
 /// part the (negative) distance to the nearest face.
-#[inline]
-fn cuboid(p: Vec3, half_extents: Vec3) -> f32 {
-    let q = p.abs() - half_extents.max(Vec3::ZERO);
-    q.max(Vec3::ZERO).length() + q.max_element().min(0.0)
+#[inline(always)]
+fn cuboid<L: Lane>(p: LaneVec3<L>, half_extents: Vec3) -> L {
+    let q = p.abs() - LaneVec3::splat(half_extents.max(Vec3::ZERO));
+    q.max(LaneVec3::splat(Vec3::ZERO)).length() + q.max_element().min(L::splat(0.0))
 }
 
 /// iq sdRoundBox: a box shrunk by `radius` and then inflated by it, so the outer size stays
 /// `half_extents`. The radius is clamped to `[0, smallest half extent]`, past which the
 /// shrunk box would turn inside out.
-#[inline]
-fn round_box(p: Vec3, half_extents: Vec3, radius: f32) -> f32 {
+#[inline(always)]
+fn round_box<L: Lane>(p: LaneVec3<L>, half_extents: Vec3, radius: f32) -> L {
     let b = half_extents.max(Vec3::ZERO);
     let r = round_box_radius(b, radius);
-    cuboid(p, b - Vec3::splat(r)) - r
+    cuboid(p, b - Vec3::splat(r)) - L::splat(r)
 }
 
 #[inline]
@@ -339,36 +350,39 @@ fn round_box_radius(half_extents: Vec3, radius: f32) -> f32 {
         .min(half_extents.max(Vec3::ZERO).min_element())
 }
 
-#[inline]
-fn plane(p: Vec3, normal: Vec3, height: f32) -> f32 {
-    p.dot(normal) - height
+#[inline(always)]
+fn plane<L: Lane>(p: LaneVec3<L>, normal: Vec3, height: f32) -> L {
+    p.dot(LaneVec3::splat(normal)) - L::splat(height)
 }
 
 /// iq sdTorus: the distance to the core circle of radius `major` in the XZ plane, minus the
 /// tube radius.
-#[inline]
-fn torus(p: Vec3, major: f32, minor: f32) -> f32 {
-    let q = Vec2::new(Vec2::new(p.x, p.z).length() - major.max(0.0), p.y);
-    q.length() - minor.max(0.0)
+#[inline(always)]
+fn torus<L: Lane>(p: LaneVec3<L>, major: f32, minor: f32) -> L {
+    let q = LaneVec2::new(
+        LaneVec2::new(p.x, p.z).length() - L::splat(major.max(0.0)),
+        p.y,
+    );
+    q.length() - L::splat(minor.max(0.0))
 }
 
 /// iq sdCappedCylinder: the 2D box distance in the (radial, height) half-plane.
-#[inline]
-fn capped_cylinder(p: Vec3, radius: f32, half_height: f32) -> f32 {
+#[inline(always)]
+fn capped_cylinder<L: Lane>(p: LaneVec3<L>, radius: f32, half_height: f32) -> L {
     let size = Vec2::new(radius, half_height).max(Vec2::ZERO);
-    let d = Vec2::new(Vec2::new(p.x, p.z).length(), p.y).abs() - size;
-    d.max_element().min(0.0) + d.max(Vec2::ZERO).length()
+    let d = LaneVec2::new(LaneVec2::new(p.x, p.z).length(), p.y).abs() - LaneVec2::splat(size);
+    d.max_element().min(L::splat(0.0)) + d.max(LaneVec2::splat(Vec2::ZERO)).length()
 }
 
 /// iq sdCapsule: distance to the segment `ab`, minus the radius.
-#[inline]
-fn capsule(p: Vec3, a: Vec3, b: Vec3, radius: f32) -> f32 {
-    let pa = p - a;
+#[inline(always)]
+fn capsule<L: Lane>(p: LaneVec3<L>, a: Vec3, b: Vec3, radius: f32) -> L {
+    let pa = p - LaneVec3::splat(a);
     let ba = b - a;
-    let h = pa.dot(ba) / ba.length_squared();
+    let h = pa.dot(LaneVec3::splat(ba)) / L::splat(ba.length_squared());
     // A degenerate segment (a == b) gives 0/0: treat it as the point a.
-    let h = if h.is_nan() { 0.0 } else { h.clamp(0.0, 1.0) };
-    (pa - ba * h).length() - radius.max(0.0)
+    let h = L::select(h.is_nan(), L::splat(0.0), h.clamp(0.0, 1.0));
+    (pa - LaneVec3::splat(ba) * h).length() - L::splat(radius.max(0.0))
 }
 
 /// The three situations a Death Star can be in; `Rim` is the only one with a crater edge.
@@ -403,14 +417,14 @@ fn death_star_kind(ra: f32, rb: f32, d: f32) -> DeathStarKind {
 /// there is no rim (disjoint spheres, or a cavity fully inside) that max is exact
 /// everywhere; iq's formula divides by `d` and assumes a rim, so those cases are handled
 /// first. When nothing is left the max is still positive everywhere, a valid bound.
-#[inline]
-fn death_star(p: Vec3, ra: f32, rb: f32, d: f32) -> f32 {
+#[inline(always)]
+fn death_star<L: Lane>(p: LaneVec3<L>, ra: f32, rb: f32, d: f32) -> L {
     let (ra, rb) = (ra.max(0.0), rb.max(0.0));
     // Mirror so the small sphere sits on +x.
     let (x, d) = if d < 0.0 { (-p.x, -d) } else { (p.x, d) };
-    let q = Vec2::new(x, Vec2::new(p.y, p.z).length());
-    let big = q.length() - ra;
-    let small = rb - (q - Vec2::new(d, 0.0)).length();
+    let q = LaneVec2::new(x, LaneVec2::new(p.y, p.z).length());
+    let big = q.length() - L::splat(ra);
+    let small = L::splat(rb) - (q - LaneVec2::splat(Vec2::new(d, 0.0))).length();
     if death_star_kind(ra, rb, d) != DeathStarKind::Rim {
         return big.max(small);
     }
@@ -419,16 +433,22 @@ fn death_star(p: Vec3, ra: f32, rb: f32, d: f32) -> f32 {
     // ra, does not cancel away the rim's position.
     let a = ((ra - rb) * (ra + rb) + d * d) / (2.0 * d);
     let b = ((ra - a) * (ra + a)).max(0.0).sqrt();
-    if q.x * b - q.y * a > d * (b - q.y).max(0.0) {
-        (q - Vec2::new(a, b)).length()
-    } else {
-        big.max(small)
-    }
+    let (a_, b_) = (L::splat(a), L::splat(b));
+    let near_rim = (q.x * b_ - q.y * a_).gt(L::splat(d) * (b_ - q.y).max(L::splat(0.0)));
+    L::select(
+        near_rim,
+        (q - LaneVec2::splat(Vec2::new(a, b))).length(),
+        big.max(small),
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn at(p: Vec3) -> LaneVec3<f32> {
+        p.into()
+    }
 
     fn check(got: f32, expected: f32) {
         assert!((got - expected).abs() <= 1e-6, "{got} != {expected}");
@@ -436,37 +456,37 @@ mod tests {
 
     #[test]
     fn sphere_and_box() {
-        check(sphere(Vec3::new(0.0, 3.0, 4.0), 2.0), 3.0);
-        check(sphere(Vec3::ZERO, 2.0), -2.0);
-        check(sphere(Vec3::X, -1.0), 1.0); // a negative radius is a point
+        check(sphere(at(Vec3::new(0.0, 3.0, 4.0)), 2.0), 3.0);
+        check(sphere(at(Vec3::ZERO), 2.0), -2.0);
+        check(sphere(at(Vec3::X), -1.0), 1.0); // a negative radius is a point
         let b = Vec3::new(1.0, 2.0, 3.0);
-        check(cuboid(Vec3::new(4.0, 6.0, 0.0), b), 5.0); // nearest is an edge
-        check(cuboid(Vec3::ZERO, b), -1.0); // nearest face is x = 1
-        check(cuboid(Vec3::new(0.0, 0.0, 5.0), b), 2.0);
+        check(cuboid(at(Vec3::new(4.0, 6.0, 0.0)), b), 5.0); // nearest is an edge
+        check(cuboid(at(Vec3::ZERO), b), -1.0); // nearest face is x = 1
+        check(cuboid(at(Vec3::new(0.0, 0.0, 5.0)), b), 2.0);
     }
 
     #[test]
     fn round_box_keeps_outer_size() {
         let b = Vec3::new(1.0, 2.0, 3.0);
-        check(round_box(Vec3::new(3.0, 0.0, 0.0), b, 0.5), 2.0);
+        check(round_box(at(Vec3::new(3.0, 0.0, 0.0)), b, 0.5), 2.0);
         // The corner is rounded: the nearest point is on the radius-0.5 sphere at (0.5, 1.5, 2.5).
-        check(round_box(b, b, 0.5), 3f32.sqrt() * 0.5 - 0.5);
+        check(round_box(at(b), b, 0.5), 3f32.sqrt() * 0.5 - 0.5);
         // An oversized radius clamps to 1: a capsule-like slab still 1 thick in x.
-        check(round_box(Vec3::new(3.0, 0.0, 0.0), b, 10.0), 2.0);
+        check(round_box(at(Vec3::new(3.0, 0.0, 0.0)), b, 10.0), 2.0);
     }
 
     #[test]
     fn revolved_shapes() {
-        check(torus(Vec3::new(3.0, 0.0, 0.0), 2.0, 0.5), 0.5);
-        check(torus(Vec3::new(0.0, 0.0, 2.0), 2.0, 0.5), -0.5);
-        check(torus(Vec3::ZERO, 2.0, 0.5), 1.5);
-        check(capped_cylinder(Vec3::new(0.0, 5.0, 0.0), 1.0, 2.0), 3.0);
-        check(capped_cylinder(Vec3::new(4.0, 6.0, 0.0), 1.0, 2.0), 5.0);
-        check(capped_cylinder(Vec3::ZERO, 1.0, 2.0), -1.0);
+        check(torus(at(Vec3::new(3.0, 0.0, 0.0)), 2.0, 0.5), 0.5);
+        check(torus(at(Vec3::new(0.0, 0.0, 2.0)), 2.0, 0.5), -0.5);
+        check(torus(at(Vec3::ZERO), 2.0, 0.5), 1.5);
+        check(capped_cylinder(at(Vec3::new(0.0, 5.0, 0.0)), 1.0, 2.0), 3.0);
+        check(capped_cylinder(at(Vec3::new(4.0, 6.0, 0.0)), 1.0, 2.0), 5.0);
+        check(capped_cylinder(at(Vec3::ZERO), 1.0, 2.0), -1.0);
         let (a, b) = (Vec3::ZERO, Vec3::Y * 2.0);
-        check(capsule(Vec3::new(0.0, 5.0, 0.0), a, b, 1.0), 2.0);
-        check(capsule(Vec3::new(3.0, 1.0, 0.0), a, b, 1.0), 2.0);
-        check(capsule(Vec3::new(3.0, 0.0, 4.0), a, a, 1.0), 4.0);
+        check(capsule(at(Vec3::new(0.0, 5.0, 0.0)), a, b, 1.0), 2.0);
+        check(capsule(at(Vec3::new(3.0, 1.0, 0.0)), a, b, 1.0), 2.0);
+        check(capsule(at(Vec3::new(3.0, 0.0, 4.0)), a, a, 1.0), 4.0);
     }
 
     #[test]
@@ -480,16 +500,28 @@ mod tests {
         assert_eq!(death_star_kind(0.5, 1.0, 0.25), Empty);
         // Unit sphere minus a unit sphere at x = 1: the rim is at x = 0.5, radius sqrt(3)/2.
         let rim = Vec3::new(0.5, 0.75f32.sqrt(), 0.0);
-        check(death_star(rim, 1.0, 1.0, 1.0), 0.0);
-        check(death_star(Vec3::new(-2.0, 0.0, 0.0), 1.0, 1.0, 1.0), 1.0);
-        check(death_star(Vec3::new(0.25, 0.0, 0.0), 1.0, 1.0, 1.0), 0.25); // in the crater
-        check(death_star(rim * 2.0, 1.0, 1.0, 1.0), 1.0); // beyond the rim, in its cone
+        check(death_star(at(rim), 1.0, 1.0, 1.0), 0.0);
+        check(
+            death_star(at(Vec3::new(-2.0, 0.0, 0.0)), 1.0, 1.0, 1.0),
+            1.0,
+        );
+        check(
+            death_star(at(Vec3::new(0.25, 0.0, 0.0)), 1.0, 1.0, 1.0),
+            0.25,
+        ); // in the crater
+        check(death_star(at(rim * 2.0), 1.0, 1.0, 1.0), 1.0); // beyond the rim, in its cone
         // Mirrored: the crater faces -x.
-        check(death_star(Vec3::new(-0.25, 0.0, 0.0), 1.0, 1.0, -1.0), 0.25);
+        check(
+            death_star(at(Vec3::new(-0.25, 0.0, 0.0)), 1.0, 1.0, -1.0),
+            0.25,
+        );
         // Empty: positive everywhere, including where the big sphere used to be.
-        assert!(death_star(Vec3::ZERO, 0.5, 1.0, 0.25) > 0.0);
+        assert!(death_star(at(Vec3::ZERO), 0.5, 1.0, 0.25) > 0.0);
         // Cavity: the hollow inside is outside the shape.
-        check(death_star(Vec3::ZERO, 2.0, 0.5, 0.0), 0.5);
-        check(death_star(Vec3::new(1.0, 0.0, 0.0), 2.0, 0.5, 0.0), -0.5);
+        check(death_star(at(Vec3::ZERO), 2.0, 0.5, 0.0), 0.5);
+        check(
+            death_star(at(Vec3::new(1.0, 0.0, 0.0)), 2.0, 0.5, 0.0),
+            -0.5,
+        );
     }
 }

@@ -3,7 +3,8 @@
 use glam::{Quat, Vec3};
 
 use crate::DistanceField;
-use crate::blend::{smooth_max, smooth_min};
+use crate::blend::{smooth_max_lanes, smooth_min_lanes};
+use crate::lanes::{Lane, LaneDistance, LaneVec3};
 use crate::primitives::Primitive;
 
 /// A signed distance function as a closed enum tree: evaluation is a `match`, never a
@@ -142,50 +143,10 @@ impl Sdf {
         }
     }
 
-    /// Signed distance (or bound, see the variant) at `p`; negative inside.
+    /// Signed distance (or bound, see the variant) at `p`; negative inside: the
+    /// [`LaneDistance`] formula at `f32`.
     pub fn distance(&self, p: Vec3) -> f32 {
-        match self {
-            Self::Primitive(shape) => shape.distance(p),
-            Self::Union(children) => children
-                .iter()
-                .fold(f32::INFINITY, |m, c| m.min(c.distance(p))),
-            Self::Intersection(children) => children
-                .iter()
-                .fold(f32::NEG_INFINITY, |m, c| m.max(c.distance(p))),
-            Self::Difference(children) => match children.split_first() {
-                None => f32::INFINITY,
-                Some((first, rest)) => rest
-                    .iter()
-                    .fold(first.distance(p), |m, c| m.max(-c.distance(p))),
-            },
-            Self::SmoothUnion { k, children } => match children.split_first() {
-                None => f32::INFINITY,
-                Some((first, rest)) => rest
-                    .iter()
-                    .fold(first.distance(p), |m, c| smooth_min(m, c.distance(p), *k)),
-            },
-            Self::SmoothIntersection { k, children } => match children.split_first() {
-                None => f32::NEG_INFINITY,
-                Some((first, rest)) => rest
-                    .iter()
-                    .fold(first.distance(p), |m, c| smooth_max(m, c.distance(p), *k)),
-            },
-            Self::SmoothDifference { k, children } => match children.split_first() {
-                None => f32::INFINITY,
-                Some((first, rest)) => rest
-                    .iter()
-                    .fold(first.distance(p), |m, c| smooth_max(m, -c.distance(p), *k)),
-            },
-            Self::Translate { offset, child } => child.distance(p - *offset),
-            Self::Rotate { rotation, child } => child.distance(rotate(rotation.conjugate(), p)),
-            Self::Scale { factor, child } => {
-                if usable_factor(*factor) {
-                    factor.abs() * child.distance(p / *factor)
-                } else {
-                    f32::INFINITY
-                }
-            }
-        }
+        self.distance_lanes(LaneVec3::from(p))
     }
 
     /// Lipschitz bound L of [`Sdf::distance`]: the primitive's ([`Primitive::lipschitz`]),
@@ -251,6 +212,70 @@ impl Sdf {
     }
 }
 
+/// The one definition of each operator and transform. A primitive is evaluated in place;
+/// below an operator the recursion is a call the compiler cannot inline, which runs with the
+/// compilation target's baseline instructions rather than the dispatched ones (entering the
+/// dispatched instruction set again at each node was measured slower: the call costs more
+/// than a small child's evaluation). The bits are the same either way.
+impl LaneDistance for Sdf {
+    #[inline(always)]
+    fn distance_lanes<L: Lane>(&self, p: LaneVec3<L>) -> L {
+        match self {
+            Self::Primitive(shape) => shape.distance_lanes(p),
+            _ => self.node_distance(p),
+        }
+    }
+}
+
+impl Sdf {
+    #[inline]
+    fn node_distance<L: Lane>(&self, p: LaneVec3<L>) -> L {
+        let inf = L::splat(f32::INFINITY);
+        match self {
+            Self::Primitive(shape) => shape.distance_lanes(p),
+            Self::Union(children) => children.iter().fold(inf, |m, c| m.min(c.distance_lanes(p))),
+            Self::Intersection(children) => children
+                .iter()
+                .fold(-inf, |m, c| m.max(c.distance_lanes(p))),
+            Self::Difference(children) => match children.split_first() {
+                None => inf,
+                Some((first, rest)) => rest
+                    .iter()
+                    .fold(first.distance_lanes(p), |m, c| m.max(-c.distance_lanes(p))),
+            },
+            Self::SmoothUnion { k, children } => match children.split_first() {
+                None => inf,
+                Some((first, rest)) => rest.iter().fold(first.distance_lanes(p), |m, c| {
+                    smooth_min_lanes(m, c.distance_lanes(p), *k)
+                }),
+            },
+            Self::SmoothIntersection { k, children } => match children.split_first() {
+                None => -inf,
+                Some((first, rest)) => rest.iter().fold(first.distance_lanes(p), |m, c| {
+                    smooth_max_lanes(m, c.distance_lanes(p), *k)
+                }),
+            },
+            Self::SmoothDifference { k, children } => match children.split_first() {
+                None => inf,
+                Some((first, rest)) => rest.iter().fold(first.distance_lanes(p), |m, c| {
+                    smooth_max_lanes(m, -c.distance_lanes(p), *k)
+                }),
+            },
+            Self::Translate { offset, child } => child.distance_lanes(p - LaneVec3::splat(*offset)),
+            Self::Rotate { rotation, child } => {
+                child.distance_lanes(rotate_lanes(rotation.conjugate(), p))
+            }
+            Self::Scale { factor, child } => {
+                if usable_factor(*factor) {
+                    L::splat(factor.abs()) * child.distance_lanes(p / L::splat(*factor))
+                } else {
+                    inf
+                }
+            }
+        }
+    }
+}
+
 impl DistanceField for Sdf {
     #[inline]
     fn distance(&self, p: Vec3) -> f32 {
@@ -270,14 +295,23 @@ impl DistanceField for Sdf {
 /// `s^2 R(u) v`, so dividing by `|q|^2` removes the scale at the cost of one division.
 #[inline]
 pub(crate) fn rotate(q: Quat, v: Vec3) -> Vec3 {
+    rotate_lanes(q, LaneVec3::from(v)).into()
+}
+
+/// [`rotate`] over any [`Lane`] type, its one definition.
+#[inline(always)]
+fn rotate_lanes<L: Lane>(q: Quat, v: LaneVec3<L>) -> LaneVec3<L> {
     let n2 = q.length_squared();
     if !n2.is_normal() {
         return v;
     }
     let w = q.w;
     let b = Vec3::new(q.x, q.y, q.z);
-    let rotated = v * (w * w - b.dot(b)) + b * (2.0 * v.dot(b)) + b.cross(v) * (2.0 * w);
-    rotated / n2
+    let lanes_b = LaneVec3::splat(b);
+    let rotated = v * L::splat(w * w - b.dot(b))
+        + lanes_b * (L::splat(2.0) * v.dot(lanes_b))
+        + lanes_b.cross(v) * L::splat(2.0 * w);
+    rotated / L::splat(n2)
 }
 
 /// Whether `p / factor` stays meaningful; smaller factors (and NaN) collapse the shape.

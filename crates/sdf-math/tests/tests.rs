@@ -4,8 +4,8 @@
 //! on every machine.
 
 use lueur_sdf_math::{
-    DistanceField, Primitive, Quat, Ray, Sdf, TraceOutcome, TraceParams, Vec3, normal,
-    normal_central, sphere_trace,
+    DistanceField, LaneDistance, PreparedSdf, Primitive, Quat, Ray, Sdf, SimdLevel, TraceOutcome,
+    TraceParams, Vec3, normal, normal_central, sphere_trace,
 };
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
@@ -350,6 +350,36 @@ mod checks {
         }
         Ok(())
     }
+    /// Every lane path the CPU has gives, for batches of 1, 7, 16 and 100 points (whole
+    /// vectors, tails, both), the bits of the scalar `distance` at each point. So the
+    /// contracts the other checks prove of the scalar field hold for the lanes too.
+    pub fn lanes_are_scalar<F: LaneDistance + DistanceField>(
+        field: &F,
+        points: &[Vec3],
+    ) -> Result<(), TestCaseError> {
+        let xs: Vec<f32> = points.iter().map(|p| p.x).collect();
+        let ys: Vec<f32> = points.iter().map(|p| p.y).collect();
+        let zs: Vec<f32> = points.iter().map(|p| p.z).collect();
+        for level in SimdLevel::available() {
+            for n in [1, 7, 16, 100].into_iter().filter(|&n| n <= points.len()) {
+                let mut out = vec![f32::NAN; n];
+                field
+                    .distance_batch_at(level, &xs[..n], &ys[..n], &zs[..n], &mut out)
+                    .unwrap();
+                for (p, got) in points.iter().zip(&out) {
+                    let want = field.distance(*p);
+                    prop_assert!(
+                        got.to_bits() == want.to_bits(),
+                        "{level:?}, batch of {n}: {got} ({:#x}) != scalar {want} ({:#x}) at {p}",
+                        got.to_bits(),
+                        want.to_bits()
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// A ray that reaches `p` at `t = back`: if a tracer would call `p` a hit, the
     /// bounds' hit intervals must hold `back`.
     pub fn hit_interval(sdf: &Sdf, p: Vec3, dir: Vec3, back: f32) -> Result<(), TestCaseError> {
@@ -431,6 +461,16 @@ macro_rules! conformance {
                         checks::bounding_box(&sdf, p)?;
                         checks::bounding_box(&sdf, q)?;
                     }
+                }
+
+                #[test]
+                fn every_lane_path_gives_the_scalar_bits(sdf in $strategy, probes in prop::collection::vec(probe(), 50)) {
+                    let points: Vec<Vec3> = probes
+                        .iter()
+                        .flat_map(|probe| <[Vec3; 2]>::from(points(&sdf, probe)))
+                        .collect();
+                    checks::lanes_are_scalar(&sdf, &points)?;
+                    checks::lanes_are_scalar(&PreparedSdf::new(&sdf), &points)?;
                 }
 
                 #[test]
