@@ -1,6 +1,7 @@
 //! Points per second of the lane paths: a few representative fields, prepared as the
 //! tracer prepares objects, evaluated at 4096 points on every path this CPU has, so that
-//! each path reads as a ratio to `Scalar` in one run.
+//! each path reads as a ratio to `Scalar` in one run; and rays per second of the stream
+//! tracer on the same fields, against `sphere_trace` one ray at a time.
 //!
 //! `cargo bench -p lueur-sdf-math --bench lanes`; the first line says which CPU features
 //! the run had.
@@ -8,7 +9,10 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use lueur_sdf_math::{LaneDistance, PreparedSdf, Quat, Sdf, SimdLevel, Vec3};
+use lueur_sdf_math::{
+    LaneDistance, PreparedSdf, Quat, Ray, Sdf, SimdLevel, TraceOutcome, TraceParams, Vec3,
+    sphere_trace, sphere_trace_stream_at,
+};
 
 const POINTS: usize = 4096;
 
@@ -97,5 +101,48 @@ fn lanes(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, lanes);
+/// 4096 rays from a sphere of radius 4 toward points near the origin (most hit, some
+/// graze or miss), with the parameters a secondary ray gets.
+fn rays() -> (Vec<Ray>, Vec<TraceParams>) {
+    let [xs, ys, zs] = points();
+    let rays: Vec<Ray> = (0..POINTS)
+        .map(|i| {
+            let j = (i * 7 + 3) % POINTS;
+            let origin = Vec3::new(xs[i], ys[i], zs[i]).normalize_or(Vec3::X) * 4.0;
+            let aim = Vec3::new(xs[j], ys[j], zs[j]) * 0.5;
+            Ray::new(origin, (aim - origin).normalize())
+        })
+        .collect();
+    let params = vec![TraceParams::default(); POINTS];
+    (rays, params)
+}
+
+fn stream(c: &mut Criterion) {
+    let (rays, params) = rays();
+    let mut out = vec![TraceOutcome::Miss { steps: 0 }; POINTS];
+    for (name, field) in fields() {
+        let mut group = c.benchmark_group(format!("stream/{name}"));
+        group.throughput(Throughput::Elements(POINTS as u64));
+        group.bench_function(BenchmarkId::from_parameter("sphere_trace"), |b| {
+            b.iter(|| {
+                for ((ray, p), o) in rays.iter().zip(&params).zip(out.iter_mut()) {
+                    *o = sphere_trace(&field, black_box(ray), p);
+                }
+                black_box(&out);
+            })
+        });
+        for level in SimdLevel::available() {
+            group.bench_function(BenchmarkId::from_parameter(format!("{level:?}")), |b| {
+                b.iter(|| {
+                    sphere_trace_stream_at(level, &field, black_box(&rays), &params, &mut out)
+                        .unwrap();
+                    black_box(&out);
+                })
+            });
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(benches, lanes, stream);
 criterion_main!(benches);

@@ -56,6 +56,7 @@ mod primitives;
 mod ray;
 mod sdf;
 mod sdf_bounds;
+mod stream;
 mod trace;
 
 pub use glam::{Quat, Vec3};
@@ -72,6 +73,7 @@ pub use crate::prepared::PreparedSdf;
 pub use crate::primitives::Primitive;
 pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
+pub use crate::stream::{sphere_trace_stream, sphere_trace_stream_at};
 pub use crate::trace::{
     HIT_ULPS, OVER_RELAXATION, TraceOutcome, TraceParams, position_rounding, sphere_trace,
     sphere_trace_relaxed,

@@ -141,37 +141,93 @@ pub fn sphere_trace<F: DistanceField + ?Sized>(
     ray: &Ray,
     params: &TraceParams,
 ) -> TraceOutcome {
-    let Some(step_scale) = step_scale(field, ray) else {
-        return TraceOutcome::GaveUp {
-            t: params.t_min,
-            steps: 0,
-        };
+    let mut march = match HartMarch::start(field, ray, params) {
+        Ok(march) => march,
+        Err(outcome) => return outcome,
     };
-
-    let mut t = params.t_min;
-    let mut steps = 0;
-    while steps < params.max_steps {
-        if t > params.t_max {
-            return TraceOutcome::Miss { steps };
+    loop {
+        match march.next_point() {
+            Err(outcome) => return outcome,
+            Ok(p) => {
+                if let Some(outcome) = march.advance(field.distance(p)) {
+                    return outcome;
+                }
+            }
         }
-        let d = field.distance(ray.at(t));
-        steps += 1;
+    }
+}
+
+/// One ray's plain sphere trace as a state machine: where to evaluate next, and what the
+/// value found there decides. [`sphere_trace`] drives it one ray at a time and
+/// `stream::sphere_trace_stream` many rays a lane each, so both take exactly the same
+/// steps.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HartMarch {
+    ray: Ray,
+    params: TraceParams,
+    step_scale: f32,
+    t: f32,
+    steps: u32,
+}
+
+impl HartMarch {
+    /// The march of `ray`, or its outcome at once for a zero or non-finite direction.
+    #[inline]
+    pub(crate) fn start<F: DistanceField + ?Sized>(
+        field: &F,
+        ray: &Ray,
+        params: &TraceParams,
+    ) -> Result<HartMarch, TraceOutcome> {
+        match step_scale(field, ray) {
+            Some(step_scale) => Ok(HartMarch {
+                ray: *ray,
+                params: *params,
+                step_scale,
+                t: params.t_min,
+                steps: 0,
+            }),
+            None => Err(TraceOutcome::GaveUp {
+                t: params.t_min,
+                steps: 0,
+            }),
+        }
+    }
+
+    /// The point to evaluate next, or the outcome if the march is over: past `t_max` is a
+    /// miss, the step cap reached short of it a give-up.
+    #[inline]
+    pub(crate) fn next_point(&self) -> Result<Vec3, TraceOutcome> {
+        if self.t > self.params.t_max {
+            Err(TraceOutcome::Miss { steps: self.steps })
+        } else if self.steps >= self.params.max_steps {
+            Err(TraceOutcome::GaveUp {
+                t: self.t,
+                steps: self.steps,
+            })
+        } else {
+            Ok(self.ray.at(self.t))
+        }
+    }
+
+    /// Takes the step that the field's value `d` at [`HartMarch::next_point`] allows;
+    /// the outcome if that ends the march (a hit, a NaN, a step too small to move `t`).
+    #[inline]
+    pub(crate) fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
+        let (t, params) = (self.t, &self.params);
+        self.steps += 1;
+        let steps = self.steps;
         if d.is_nan() {
-            return TraceOutcome::GaveUp { t, steps };
+            return Some(TraceOutcome::GaveUp { t, steps });
         }
         if d < params.eps_abs.max(params.eps_rel * t) {
-            return TraceOutcome::Hit { t, steps };
+            return Some(TraceOutcome::Hit { t, steps });
         }
-        let next = t + d * step_scale;
+        let next = t + d * self.step_scale;
         if next == t {
-            return TraceOutcome::GaveUp { t, steps };
+            return Some(TraceOutcome::GaveUp { t, steps });
         }
-        t = next;
-    }
-    if t > params.t_max {
-        TraceOutcome::Miss { steps }
-    } else {
-        TraceOutcome::GaveUp { t, steps }
+        self.t = next;
+        None
     }
 }
 
