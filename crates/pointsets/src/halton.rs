@@ -22,7 +22,7 @@ static PRIMES: LazyLock<Vec<u64>> = LazyLock::new(|| {
         if primes
             .iter()
             .take_while(|&&p| p * p <= candidate)
-            .all(|&p| candidate % p != 0)
+            .all(|&p| !candidate.is_multiple_of(p))
         {
             primes.push(candidate);
         }

@@ -317,7 +317,7 @@ impl PointSet {
         if dim == 0 {
             return Err(PointSetError::ZeroDimensions);
         }
-        if data.len() % dim != 0 {
+        if !data.len().is_multiple_of(dim) {
             return Err(PointSetError::RaggedData {
                 len: data.len(),
                 dim,

@@ -61,7 +61,7 @@ pub fn pmj02_u32(n: usize, seed: u64) -> Vec<[u32; 2]> {
     while count < n {
         let target = (2 * count).min(n);
         builder.start_level(2 * count);
-        if count.trailing_zeros() % 2 == 0 {
+        if count.trailing_zeros().is_multiple_of(2) {
             builder.extend_even(count, target);
         } else {
             builder.extend_odd(count, target);

@@ -21,7 +21,7 @@ pub fn strata_shape(n: usize) -> [usize; 2] {
     while (columns + 1) * (columns + 1) <= n {
         columns += 1;
     }
-    while n % columns != 0 {
+    while !n.is_multiple_of(columns) {
         columns -= 1;
     }
     [columns, n / columns]
