@@ -10,8 +10,9 @@ use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use lueur_sdf_math::{
-    LaneDistance, PreparedSdf, Quat, Ray, Sdf, SimdLevel, TraceOutcome, TraceParams, Vec3,
-    sphere_trace, sphere_trace_stream_at,
+    LaneDistance, OVER_RELAXATION, PreparedSdf, Quat, Ray, Sdf, SimdLevel, TraceOutcome,
+    TraceParams, Vec3, sphere_trace, sphere_trace_relaxed, sphere_trace_relaxed_stream_at,
+    sphere_trace_stream_at,
 };
 
 const POINTS: usize = 4096;
@@ -136,6 +137,32 @@ fn stream(c: &mut Criterion) {
                 b.iter(|| {
                     sphere_trace_stream_at(level, &field, black_box(&rays), &params, &mut out)
                         .unwrap();
+                    black_box(&out);
+                })
+            });
+        }
+        group.bench_function(BenchmarkId::from_parameter("sphere_trace_relaxed"), |b| {
+            b.iter(|| {
+                for ((ray, p), o) in rays.iter().zip(&params).zip(out.iter_mut()) {
+                    *o = sphere_trace_relaxed(&field, black_box(ray), p, OVER_RELAXATION);
+                }
+                black_box(&out);
+            })
+        });
+        for level in SimdLevel::available() {
+            let id = format!("relaxed {level:?}");
+            group.bench_function(BenchmarkId::from_parameter(id), |b| {
+                b.iter(|| {
+                    let rays = black_box(&rays);
+                    sphere_trace_relaxed_stream_at(
+                        level,
+                        &field,
+                        rays,
+                        &params,
+                        OVER_RELAXATION,
+                        &mut out,
+                    )
+                    .unwrap();
                     black_box(&out);
                 })
             });

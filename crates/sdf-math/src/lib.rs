@@ -73,7 +73,10 @@ pub use crate::prepared::PreparedSdf;
 pub use crate::primitives::Primitive;
 pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
-pub use crate::stream::{sphere_trace_stream, sphere_trace_stream_at};
+pub use crate::stream::{
+    sphere_trace_relaxed_stream, sphere_trace_relaxed_stream_at, sphere_trace_stream,
+    sphere_trace_stream_at,
+};
 pub use crate::trace::{
     HIT_ULPS, OVER_RELAXATION, TraceOutcome, TraceParams, position_rounding, sphere_trace,
     sphere_trace_relaxed,

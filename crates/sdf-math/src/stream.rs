@@ -1,21 +1,23 @@
-//! Sphere tracing a stream of rays, one lane of a SIMD vector each.
+//! Sphere tracing a stream of rays, one lane of a SIMD vector each, plain or over-relaxed.
 //!
 //! The field is the expensive part of a march and the same formula for every ray, so it is
 //! evaluated for a vector of rays at once ([`LaneDistance::distance_lanes`]); the control
 //! of each march (hit, miss, give-up, the next `t`) stays per lane, in the state machine
-//! [`sphere_trace`] itself runs (`HartMarch`). A lane whose ray is done takes the next ray
+//! [`sphere_trace`] itself runs (`HartMarch`; `RelaxedMarch` for
+//! [`sphere_trace_relaxed`]). A lane whose ray is done takes the next ray
 //! of the stream at once, so the vector stays full until the stream runs dry, whatever the
 //! mix of short and long marches.
 //!
-//! Contract: every ray's outcome is, bit for bit, what [`sphere_trace`] gives for it, on
+//! Contract: every ray's outcome is, bit for bit, what [`sphere_trace`] (or
+//! [`sphere_trace_relaxed`]) gives for it, on
 //! every [`SimdLevel`] and for any length of stream: each lane's field value equals the
 //! scalar one (the lane contract), and the march around it is the same code.
 
 use crate::lanes::{Lane, LaneDistance, LaneKernel, LaneVec3, SimdLevel, UnavailableLevel};
-use crate::trace::HartMarch;
+use crate::trace::{HartMarch, RelaxedMarch};
 #[cfg(doc)]
-use crate::trace::sphere_trace;
-use crate::{DistanceField, Ray, TraceOutcome, TraceParams};
+use crate::trace::{sphere_trace, sphere_trace_relaxed};
+use crate::{DistanceField, Ray, TraceOutcome, TraceParams, Vec3};
 
 /// The widest vector of any [`SimdLevel`].
 const MAX_LANES: usize = 16;
@@ -51,6 +53,66 @@ pub fn sphere_trace_stream_at<F>(
 where
     F: LaneDistance + DistanceField + ?Sized,
 {
+    check_lengths(rays, params, out);
+    level.dispatch(Stream {
+        field,
+        rays,
+        params,
+        out,
+        start: |ray: &Ray, params: &TraceParams| HartMarch::start(field, ray, params),
+    })
+}
+
+/// Traces every ray of `rays` with its `params` through `field` by over-relaxed sphere
+/// tracing with factors up to `omega_max`, writing each outcome to `out`, on the widest
+/// path this CPU has.
+///
+/// # Panics
+/// If `rays`, `params` and `out` differ in length.
+pub fn sphere_trace_relaxed_stream<F>(
+    field: &F,
+    rays: &[Ray],
+    params: &[TraceParams],
+    omega_max: f32,
+    out: &mut [TraceOutcome],
+) where
+    F: LaneDistance + DistanceField + ?Sized,
+{
+    // `detect` only returns levels the CPU has.
+    let _ =
+        sphere_trace_relaxed_stream_at(SimdLevel::detect(), field, rays, params, omega_max, out);
+}
+
+/// [`sphere_trace_relaxed_stream`] on a forced path; the same outcomes on every path.
+///
+/// # Panics
+/// If `rays`, `params` and `out` differ in length.
+pub fn sphere_trace_relaxed_stream_at<F>(
+    level: SimdLevel,
+    field: &F,
+    rays: &[Ray],
+    params: &[TraceParams],
+    omega_max: f32,
+    out: &mut [TraceOutcome],
+) -> Result<(), UnavailableLevel>
+where
+    F: LaneDistance + DistanceField + ?Sized,
+{
+    if !(omega_max > 1.0 && omega_max.is_finite()) {
+        // As `sphere_trace_relaxed` does: no factor above 1 is the plain march.
+        return sphere_trace_stream_at(level, field, rays, params, out);
+    }
+    check_lengths(rays, params, out);
+    level.dispatch(Stream {
+        field,
+        rays,
+        params,
+        out,
+        start: |ray: &Ray, params: &TraceParams| RelaxedMarch::start(field, ray, params, omega_max),
+    })
+}
+
+fn check_lengths(rays: &[Ray], params: &[TraceParams], out: &[TraceOutcome]) {
     assert!(
         rays.len() == params.len() && rays.len() == out.len(),
         "sphere_trace_stream: {} rays, {} parameters, {} outcomes",
@@ -58,38 +120,68 @@ where
         params.len(),
         out.len()
     );
-    level.dispatch(Stream {
-        field,
-        rays,
-        params,
-        out,
-    })
 }
 
-/// The kernel behind [`sphere_trace_stream_at`].
-struct Stream<'a, F: ?Sized> {
+/// One ray's march, plain or relaxed, as the stream drives it.
+trait March: Copy {
+    fn next_point(&self) -> Result<Vec3, TraceOutcome>;
+    fn advance(&mut self, d: f32) -> Option<TraceOutcome>;
+}
+
+impl March for HartMarch {
+    #[inline(always)]
+    fn next_point(&self) -> Result<Vec3, TraceOutcome> {
+        HartMarch::next_point(self)
+    }
+
+    #[inline(always)]
+    fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
+        HartMarch::advance(self, d)
+    }
+}
+
+impl March for RelaxedMarch {
+    #[inline(always)]
+    fn next_point(&self) -> Result<Vec3, TraceOutcome> {
+        RelaxedMarch::next_point(self)
+    }
+
+    #[inline(always)]
+    fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
+        RelaxedMarch::advance(self, d)
+    }
+}
+
+/// The kernel behind both streams: `start` begins a ray's march.
+struct Stream<'a, F: ?Sized, S> {
     field: &'a F,
     rays: &'a [Ray],
     params: &'a [TraceParams],
     out: &'a mut [TraceOutcome],
+    start: S,
 }
 
 /// A lane's march and the index of its ray in the stream.
 #[derive(Clone, Copy)]
-struct InFlight {
-    march: HartMarch,
+struct InFlight<M> {
+    march: M,
     ray: usize,
 }
 
-impl<F: LaneDistance + DistanceField + ?Sized> Stream<'_, F> {
+impl<F, S, M> Stream<'_, F, S>
+where
+    F: LaneDistance + DistanceField + ?Sized,
+    S: Fn(&Ray, &TraceParams) -> Result<M, TraceOutcome>,
+    M: March,
+{
     /// The next ray of the stream that needs the field at all, from `*next` on; rays that
     /// end before their first evaluation get their outcome here.
     #[inline(always)]
-    fn take(&mut self, next: &mut usize) -> Option<InFlight> {
+    fn take(&mut self, next: &mut usize) -> Option<InFlight<M>> {
         while *next < self.rays.len() {
             let ray = *next;
             *next += 1;
-            match HartMarch::start(self.field, &self.rays[ray], &self.params[ray]) {
+            match (self.start)(&self.rays[ray], &self.params[ray]) {
                 Ok(march) if march.next_point().is_ok() => return Some(InFlight { march, ray }),
                 Ok(march) => self.out[ray] = march.next_point().expect_err("checked"),
                 Err(outcome) => self.out[ray] = outcome,
@@ -99,13 +191,18 @@ impl<F: LaneDistance + DistanceField + ?Sized> Stream<'_, F> {
     }
 }
 
-impl<F: LaneDistance + DistanceField + ?Sized> LaneKernel for Stream<'_, F> {
+impl<F, S, M> LaneKernel for Stream<'_, F, S>
+where
+    F: LaneDistance + DistanceField + ?Sized,
+    S: Fn(&Ray, &TraceParams) -> Result<M, TraceOutcome>,
+    M: March,
+{
     type Output = ();
 
     #[inline(always)]
     fn run<L: Lane>(mut self) {
         let lanes = L::LANES.min(MAX_LANES);
-        let mut flight: [Option<InFlight>; MAX_LANES] = [None; MAX_LANES];
+        let mut flight: [Option<InFlight<M>>; MAX_LANES] = [None; MAX_LANES];
         let mut next = 0;
         for slot in flight.iter_mut().take(lanes) {
             *slot = self.take(&mut next);
@@ -115,7 +212,7 @@ impl<F: LaneDistance + DistanceField + ?Sized> LaneKernel for Stream<'_, F> {
         while flight[..lanes].iter().any(Option::is_some) {
             for (lane, slot) in flight[..lanes].iter().enumerate() {
                 // An idle lane evaluates the origin; its value is never read.
-                let p = slot.map_or(glam::Vec3::ZERO, |f| {
+                let p = slot.map_or(Vec3::ZERO, |f| {
                     f.march
                         .next_point()
                         .expect("lanes in flight have a next point")
@@ -153,7 +250,7 @@ mod tests {
     use glam::{Quat, Vec3};
 
     use super::*;
-    use crate::{PreparedSdf, Sdf, sphere_trace};
+    use crate::{OVER_RELAXATION, PreparedSdf, Sdf, sphere_trace, sphere_trace_relaxed};
 
     /// An outcome as bits, so that equality is bitwise (`-0.0 != 0.0`, NaN == NaN).
     fn bits(o: &TraceOutcome) -> (u8, u32, u32) {
@@ -222,25 +319,44 @@ mod tests {
         ]
     }
 
+    /// Both streams against their scalar tracers; `omega_max` 1 is the plain march.
     fn check<F: LaneDistance + DistanceField>(name: &str, field: &F) {
-        for n in [1, 7, 16, 100] {
-            let (rays, params) = rays(n);
-            let expected: Vec<_> = rays
-                .iter()
-                .zip(&params)
-                .map(|(r, p)| bits(&sphere_trace(field, r, p)))
-                .collect();
-            for level in SimdLevel::available() {
-                let mut out = vec![TraceOutcome::Miss { steps: u32::MAX }; n];
-                sphere_trace_stream_at(level, field, &rays, &params, &mut out).unwrap();
-                let got: Vec<_> = out.iter().map(bits).collect();
-                assert_eq!(got, expected, "{name}, {n} rays, {level:?}");
+        for omega_max in [1.0, 2.0, OVER_RELAXATION] {
+            for n in [1, 7, 16, 100] {
+                let (rays, params) = rays(n);
+                let expected: Vec<_> = rays
+                    .iter()
+                    .zip(&params)
+                    .map(|(r, p)| bits(&sphere_trace_relaxed(field, r, p, omega_max)))
+                    .collect();
+                for level in SimdLevel::available() {
+                    let mut out = vec![TraceOutcome::Miss { steps: u32::MAX }; n];
+                    sphere_trace_relaxed_stream_at(
+                        level, field, &rays, &params, omega_max, &mut out,
+                    )
+                    .unwrap();
+                    let got: Vec<_> = out.iter().map(bits).collect();
+                    assert_eq!(
+                        got, expected,
+                        "{name}, omega {omega_max}, {n} rays, {level:?}"
+                    );
+                    if omega_max == 1.0 {
+                        sphere_trace_stream_at(level, field, &rays, &params, &mut out).unwrap();
+                        let plain: Vec<_> = out.iter().map(bits).collect();
+                        let scalar: Vec<_> = rays
+                            .iter()
+                            .zip(&params)
+                            .map(|(r, p)| bits(&sphere_trace(field, r, p)))
+                            .collect();
+                        assert_eq!(plain, scalar, "{name}, plain, {n} rays, {level:?}");
+                    }
+                }
             }
         }
     }
 
     #[test]
-    fn every_ray_of_a_stream_takes_the_scalar_tracers_steps() {
+    fn every_ray_of_a_stream_takes_the_scalar_tracers_steps_plain_or_relaxed() {
         for (name, sdf) in fields() {
             check(name, &sdf);
             check(

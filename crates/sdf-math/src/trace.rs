@@ -277,74 +277,144 @@ pub fn sphere_trace_relaxed<F: DistanceField + ?Sized>(
     if !(omega_max > 1.0 && omega_max.is_finite()) {
         return sphere_trace(field, ray, params);
     }
-    let Some(step_scale) = step_scale(field, ray) else {
-        return TraceOutcome::GaveUp {
-            t: params.t_min,
-            steps: 0,
-        };
+    let mut march = match RelaxedMarch::start(field, ray, params, omega_max) {
+        Ok(march) => march,
+        Err(outcome) => return outcome,
     };
-
-    let mut t = params.t_min;
-    // The previous sample and its field value; the step from it to `t` in field units
-    // (`omega * prev_d`, 0 before the first step); whether that step was relaxed and so
-    // must pass the check before `t` is trusted.
-    let (mut prev_t, mut prev_d, mut last_step) = (t, 0.0f32, 0.0f32);
-    let mut unchecked = false;
-    let mut steps = 0;
-    while steps < params.max_steps {
-        if t > params.t_max {
-            // Only plain steps cross t_max.
-            return TraceOutcome::Miss { steps };
+    loop {
+        match march.next_point() {
+            Err(outcome) => return outcome,
+            Ok(p) => {
+                if let Some(outcome) = march.advance(field.distance(p)) {
+                    return outcome;
+                }
+            }
         }
-        let d = field.distance(ray.at(t));
-        steps += 1;
+    }
+}
+
+/// One ray's over-relaxed sphere trace as a state machine, as [`HartMarch`] is for the
+/// plain one: [`sphere_trace_relaxed`] drives it one ray at a time and
+/// `stream::sphere_trace_relaxed_stream` many rays a lane each.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RelaxedMarch {
+    ray: Ray,
+    params: TraceParams,
+    omega_max: f32,
+    step_scale: f32,
+    t: f32,
+    /// The previous sample and its field value; the step from it to `t` in field units
+    /// (`omega * prev_d`, 0 before the first step); whether that step was relaxed and so
+    /// must pass the check before `t` is trusted.
+    prev_t: f32,
+    prev_d: f32,
+    last_step: f32,
+    unchecked: bool,
+    steps: u32,
+}
+
+impl RelaxedMarch {
+    /// The march of `ray` with factors up to `omega_max` (above 1 and finite: below that
+    /// the plain march is the one to run), or its outcome at once for a zero or non-finite
+    /// direction.
+    #[inline]
+    pub(crate) fn start<F: DistanceField + ?Sized>(
+        field: &F,
+        ray: &Ray,
+        params: &TraceParams,
+        omega_max: f32,
+    ) -> Result<RelaxedMarch, TraceOutcome> {
+        match step_scale(field, ray) {
+            Some(step_scale) => Ok(RelaxedMarch {
+                ray: *ray,
+                params: *params,
+                omega_max,
+                step_scale,
+                t: params.t_min,
+                prev_t: params.t_min,
+                prev_d: 0.0,
+                last_step: 0.0,
+                unchecked: false,
+                steps: 0,
+            }),
+            None => Err(TraceOutcome::GaveUp {
+                t: params.t_min,
+                steps: 0,
+            }),
+        }
+    }
+
+    /// The point to evaluate next, or the outcome if the march is over. At the step cap a
+    /// relaxed step not yet checked is taken back to the safe one, so a `GaveUp` reports
+    /// a checked point; only plain steps cross `t_max`, so a miss is declared from one.
+    #[inline]
+    pub(crate) fn next_point(&self) -> Result<Vec3, TraceOutcome> {
+        let steps = self.steps;
+        if steps >= self.params.max_steps {
+            let t = if self.unchecked {
+                self.prev_t + self.prev_d * self.step_scale
+            } else {
+                self.t
+            };
+            return Err(if t > self.params.t_max {
+                TraceOutcome::Miss { steps }
+            } else {
+                TraceOutcome::GaveUp { t, steps }
+            });
+        }
+        if self.t > self.params.t_max {
+            return Err(TraceOutcome::Miss { steps });
+        }
+        Ok(self.ray.at(self.t))
+    }
+
+    /// Checks the last step and takes the next one from the field's value `d` at
+    /// [`RelaxedMarch::next_point`]; the outcome if that ends the march.
+    #[inline]
+    pub(crate) fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
+        let (t, params) = (self.t, &self.params);
+        self.steps += 1;
+        let steps = self.steps;
         if d.is_nan() {
-            return TraceOutcome::GaveUp { t, steps };
+            return Some(TraceOutcome::GaveUp { t, steps });
         }
         let eps = params.eps_abs.max(params.eps_rel * t);
-        if unchecked {
-            unchecked = false;
+        if self.unchecked {
+            self.unchecked = false;
             // Written so that a NaN sum also fails (and takes the safe path).
-            if !(prev_d + d - 2.0 * eps >= last_step) {
-                t = prev_t + prev_d * step_scale;
-                last_step = prev_d;
-                continue;
+            if !(self.prev_d + d - 2.0 * eps >= self.last_step) {
+                self.t = self.prev_t + self.prev_d * self.step_scale;
+                self.last_step = self.prev_d;
+                return None;
             }
         }
         if d < eps {
-            return TraceOutcome::Hit { t, steps };
+            return Some(TraceOutcome::Hit { t, steps });
         }
-        let omega = if last_step > 0.0 {
-            let k = ((d - prev_d) / last_step).clamp(-1.0, 1.0);
+        let omega = if self.last_step > 0.0 {
+            let k = ((d - self.prev_d) / self.last_step).clamp(-1.0, 1.0);
             // 1 - k = 0 gives +inf, clamped to omega_max; a NaN k (infinite distances)
             // gives a NaN omega, which takes the plain step below.
-            (RELAXATION_MARGIN * (2.0 - 2.0 * eps / d) / (1.0 - k)).clamp(1.0, omega_max)
+            (RELAXATION_MARGIN * (2.0 - 2.0 * eps / d) / (1.0 - k)).clamp(1.0, self.omega_max)
         } else {
             1.0
         };
-        let safe = d * step_scale;
+        let safe = d * self.step_scale;
         let relaxed = t + omega * safe;
         let next = if omega > 1.0 && relaxed <= params.t_max {
-            unchecked = true;
-            last_step = omega * d;
+            self.unchecked = true;
+            self.last_step = omega * d;
             relaxed
         } else {
-            last_step = d;
+            self.last_step = d;
             t + safe
         };
         if next == t {
-            return TraceOutcome::GaveUp { t, steps };
+            return Some(TraceOutcome::GaveUp { t, steps });
         }
-        (prev_t, prev_d) = (t, d);
-        t = next;
-    }
-    if unchecked {
-        t = prev_t + prev_d * step_scale;
-    }
-    if t > params.t_max {
-        TraceOutcome::Miss { steps }
-    } else {
-        TraceOutcome::GaveUp { t, steps }
+        (self.prev_t, self.prev_d) = (t, d);
+        self.t = next;
+        None
     }
 }
 
