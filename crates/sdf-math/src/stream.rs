@@ -14,7 +14,7 @@
 //! scalar one (the lane contract), and the march around it is the same code.
 
 use crate::lanes::{Lane, LaneDistance, LaneKernel, LaneVec3, SimdLevel, UnavailableLevel};
-use crate::trace::{HartMarch, RelaxedMarch};
+use crate::trace::{HartMarch, March, RelaxedMarch};
 #[cfg(doc)]
 use crate::trace::{sphere_trace, sphere_trace_relaxed};
 use crate::{DistanceField, Ray, TraceOutcome, TraceParams, Vec3};
@@ -120,36 +120,6 @@ fn check_lengths(rays: &[Ray], params: &[TraceParams], out: &[TraceOutcome]) {
         params.len(),
         out.len()
     );
-}
-
-/// One ray's march, plain or relaxed, as the stream drives it.
-trait March: Copy {
-    fn next_point(&self) -> Result<Vec3, TraceOutcome>;
-    fn advance(&mut self, d: f32) -> Option<TraceOutcome>;
-}
-
-impl March for HartMarch {
-    #[inline(always)]
-    fn next_point(&self) -> Result<Vec3, TraceOutcome> {
-        HartMarch::next_point(self)
-    }
-
-    #[inline(always)]
-    fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
-        HartMarch::advance(self, d)
-    }
-}
-
-impl March for RelaxedMarch {
-    #[inline(always)]
-    fn next_point(&self) -> Result<Vec3, TraceOutcome> {
-        RelaxedMarch::next_point(self)
-    }
-
-    #[inline(always)]
-    fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
-        RelaxedMarch::advance(self, d)
-    }
 }
 
 /// The kernel behind both streams: `start` begins a ray's march.

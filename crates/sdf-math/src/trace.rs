@@ -141,10 +141,26 @@ pub fn sphere_trace<F: DistanceField + ?Sized>(
     ray: &Ray,
     params: &TraceParams,
 ) -> TraceOutcome {
-    let mut march = match HartMarch::start(field, ray, params) {
-        Ok(march) => march,
-        Err(outcome) => return outcome,
-    };
+    match HartMarch::start(field, ray, params) {
+        Ok(march) => run_to_end(march, field),
+        Err(outcome) => outcome,
+    }
+}
+
+/// One ray's march as a state machine: where to evaluate next (or how it ended), and what
+/// the value found there decides. The scalar tracers drive one ray to its end
+/// ([`run_to_end`]); the stream tracers drive one per lane.
+pub(crate) trait March: Copy {
+    /// The point to evaluate next, or the outcome if the march is over.
+    fn next_point(&self) -> Result<Vec3, TraceOutcome>;
+    /// Takes the step the field's value `d` at [`March::next_point`] allows; the outcome
+    /// if that ends the march.
+    fn advance(&mut self, d: f32) -> Option<TraceOutcome>;
+}
+
+/// Drives `march` through `field`, one evaluation at a time, to its outcome.
+#[inline]
+fn run_to_end<M: March, F: DistanceField + ?Sized>(mut march: M, field: &F) -> TraceOutcome {
     loop {
         match march.next_point() {
             Err(outcome) => return outcome,
@@ -192,11 +208,13 @@ impl HartMarch {
             }),
         }
     }
+}
 
+impl March for HartMarch {
     /// The point to evaluate next, or the outcome if the march is over: past `t_max` is a
     /// miss, the step cap reached short of it a give-up.
     #[inline]
-    pub(crate) fn next_point(&self) -> Result<Vec3, TraceOutcome> {
+    fn next_point(&self) -> Result<Vec3, TraceOutcome> {
         if self.t > self.params.t_max {
             Err(TraceOutcome::Miss { steps: self.steps })
         } else if self.steps >= self.params.max_steps {
@@ -212,7 +230,7 @@ impl HartMarch {
     /// Takes the step that the field's value `d` at [`HartMarch::next_point`] allows;
     /// the outcome if that ends the march (a hit, a NaN, a step too small to move `t`).
     #[inline]
-    pub(crate) fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
+    fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
         let (t, params) = (self.t, &self.params);
         self.steps += 1;
         let steps = self.steps;
@@ -277,19 +295,9 @@ pub fn sphere_trace_relaxed<F: DistanceField + ?Sized>(
     if !(omega_max > 1.0 && omega_max.is_finite()) {
         return sphere_trace(field, ray, params);
     }
-    let mut march = match RelaxedMarch::start(field, ray, params, omega_max) {
-        Ok(march) => march,
-        Err(outcome) => return outcome,
-    };
-    loop {
-        match march.next_point() {
-            Err(outcome) => return outcome,
-            Ok(p) => {
-                if let Some(outcome) = march.advance(field.distance(p)) {
-                    return outcome;
-                }
-            }
-        }
+    match RelaxedMarch::start(field, ray, params, omega_max) {
+        Ok(march) => run_to_end(march, field),
+        Err(outcome) => outcome,
     }
 }
 
@@ -343,12 +351,14 @@ impl RelaxedMarch {
             }),
         }
     }
+}
 
+impl March for RelaxedMarch {
     /// The point to evaluate next, or the outcome if the march is over. At the step cap a
     /// relaxed step not yet checked is taken back to the safe one, so a `GaveUp` reports
     /// a checked point; only plain steps cross `t_max`, so a miss is declared from one.
     #[inline]
-    pub(crate) fn next_point(&self) -> Result<Vec3, TraceOutcome> {
+    fn next_point(&self) -> Result<Vec3, TraceOutcome> {
         let steps = self.steps;
         if steps >= self.params.max_steps {
             let t = if self.unchecked {
@@ -371,7 +381,7 @@ impl RelaxedMarch {
     /// Checks the last step and takes the next one from the field's value `d` at
     /// [`RelaxedMarch::next_point`]; the outcome if that ends the march.
     #[inline]
-    pub(crate) fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
+    fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
         let (t, params) = (self.t, &self.params);
         self.steps += 1;
         let steps = self.steps;
