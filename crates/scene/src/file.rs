@@ -4,16 +4,18 @@
 
 use std::collections::HashMap;
 
-use crate::{Camera, Light, Object, QuadSampling, RenderSettings, Scene, SceneError, Strategy};
 use glam::Vec3;
 use lueur_materials::Material;
 use lueur_sampling::SamplerKind;
 use toml::de::{DeTable, DeValue};
 
-use crate::SceneFileError;
 use crate::overrides;
 use crate::parse::{Check, Result, Source, Table, as_table, did_you_mean};
 use crate::shape::parse_shape;
+use crate::{
+    Camera, Light, MAX_IMAGE_SIDE, MAX_SPP, Object, QuadSampling, RenderSettings, Scene,
+    SceneError, SceneFileError, Strategy,
+};
 
 /// A parsed scene file: what to render and how.
 #[derive(Clone, Debug)]
@@ -67,10 +69,10 @@ pub fn parse_scene_with(
     let mut settings = RenderSettings::default();
     if let Some(image) = top.table(&src, "image")? {
         image.deny_unknown(&src, &["width", "height"])?;
-        if let Some(w) = image.u32_in(&src, "width", 1, 65_536)? {
+        if let Some(w) = image.u32_in(&src, "width", 1, MAX_IMAGE_SIDE)? {
             settings.width = w;
         }
-        if let Some(h) = image.u32_in(&src, "height", 1, 65_536)? {
+        if let Some(h) = image.u32_in(&src, "height", 1, MAX_IMAGE_SIDE)? {
             settings.height = h;
         }
     }
@@ -184,7 +186,7 @@ fn parse_render(
             "quad_sampling",
         ],
     )?;
-    if let Some(spp) = render.u32_in(src, "spp", 1, 1 << 24)? {
+    if let Some(spp) = render.u32_in(src, "spp", 1, MAX_SPP)? {
         settings.spp = spp;
     }
     if let Some((name, span)) = render.str(src, "strategy")? {

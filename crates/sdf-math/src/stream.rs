@@ -131,11 +131,13 @@ struct Stream<'a, F: ?Sized, S> {
     start: S,
 }
 
-/// A lane's march and the index of its ray in the stream.
+/// A lane's march, the index of its ray in the stream, and the point its march evaluates
+/// next.
 #[derive(Clone, Copy)]
 struct InFlight<M> {
     march: M,
     ray: usize,
+    point: Vec3,
 }
 
 impl<F, S, M> Stream<'_, F, S>
@@ -151,9 +153,9 @@ where
         while *next < self.rays.len() {
             let ray = *next;
             *next += 1;
-            match (self.start)(&self.rays[ray], &self.params[ray]) {
-                Ok(march) if march.next_point().is_ok() => return Some(InFlight { march, ray }),
-                Ok(march) => self.out[ray] = march.next_point().expect_err("checked"),
+            let started = (self.start)(&self.rays[ray], &self.params[ray]);
+            match started.and_then(|march| Ok((march, march.next_point()?))) {
+                Ok((march, point)) => return Some(InFlight { march, ray, point }),
                 Err(outcome) => self.out[ray] = outcome,
             }
         }
@@ -182,11 +184,7 @@ where
         while flight[..lanes].iter().any(Option::is_some) {
             for (lane, slot) in flight[..lanes].iter().enumerate() {
                 // An idle lane evaluates the origin; its value is never read.
-                let p = slot.map_or(Vec3::ZERO, |f| {
-                    f.march
-                        .next_point()
-                        .expect("lanes in flight have a next point")
-                });
+                let p = slot.map_or(Vec3::ZERO, |f| f.point);
                 (xs[lane], ys[lane], zs[lane]) = (p.x, p.y, p.z);
             }
             let p = LaneVec3::new(
@@ -199,13 +197,13 @@ where
                 let Some(mut f) = flight[lane] else {
                     continue;
                 };
-                let done = f
-                    .march
-                    .advance(d[lane])
-                    .or_else(|| f.march.next_point().err());
-                flight[lane] = match done {
-                    None => Some(f),
-                    Some(outcome) => {
+                let next_point = match f.march.advance(d[lane]) {
+                    None => f.march.next_point(),
+                    Some(outcome) => Err(outcome),
+                };
+                flight[lane] = match next_point {
+                    Ok(point) => Some(InFlight { point, ..f }),
+                    Err(outcome) => {
                         self.out[f.ray] = outcome;
                         self.take(&mut next)
                     }
