@@ -306,11 +306,9 @@ pub fn sphere_trace_relaxed<F: DistanceField + ?Sized>(
 /// `stream::sphere_trace_relaxed_stream` many rays a lane each.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct RelaxedMarch {
-    ray: Ray,
-    params: TraceParams,
+    /// The ray, its parameters and step scale, the current `t` and the steps spent.
+    plain: HartMarch,
     omega_max: f32,
-    step_scale: f32,
-    t: f32,
     /// The previous sample and its field value; the step from it to `t` in field units
     /// (`omega * prev_d`, 0 before the first step); whether that step was relaxed and so
     /// must pass the check before `t` is trusted.
@@ -318,7 +316,6 @@ pub(crate) struct RelaxedMarch {
     prev_d: f32,
     last_step: f32,
     unchecked: bool,
-    steps: u32,
 }
 
 impl RelaxedMarch {
@@ -332,59 +329,43 @@ impl RelaxedMarch {
         params: &TraceParams,
         omega_max: f32,
     ) -> Result<RelaxedMarch, TraceOutcome> {
-        match step_scale(field, ray) {
-            Some(step_scale) => Ok(RelaxedMarch {
-                ray: *ray,
-                params: *params,
-                omega_max,
-                step_scale,
-                t: params.t_min,
-                prev_t: params.t_min,
-                prev_d: 0.0,
-                last_step: 0.0,
-                unchecked: false,
-                steps: 0,
-            }),
-            None => Err(TraceOutcome::GaveUp {
-                t: params.t_min,
-                steps: 0,
-            }),
-        }
+        HartMarch::start(field, ray, params).map(|plain| RelaxedMarch {
+            plain,
+            omega_max,
+            prev_t: params.t_min,
+            prev_d: 0.0,
+            last_step: 0.0,
+            unchecked: false,
+        })
     }
 }
 
 impl March for RelaxedMarch {
-    /// The point to evaluate next, or the outcome if the march is over. At the step cap a
-    /// relaxed step not yet checked is taken back to the safe one, so a `GaveUp` reports
-    /// a checked point; only plain steps cross `t_max`, so a miss is declared from one.
+    /// The point to evaluate next, or the outcome if the march is over, as for the plain
+    /// march, except that at the step cap a relaxed step not yet checked is taken back to
+    /// the safe one, so a `GaveUp` reports a checked point (only plain steps cross
+    /// `t_max`, so a miss is declared from one).
     #[inline]
     fn next_point(&self) -> Result<Vec3, TraceOutcome> {
-        let steps = self.steps;
-        if steps >= self.params.max_steps {
-            let t = if self.unchecked {
-                self.prev_t + self.prev_d * self.step_scale
-            } else {
-                self.t
-            };
-            return Err(if t > self.params.t_max {
-                TraceOutcome::Miss { steps }
-            } else {
-                TraceOutcome::GaveUp { t, steps }
-            });
+        let HartMarch { params, steps, .. } = self.plain;
+        if !(self.unchecked && steps >= params.max_steps) {
+            return self.plain.next_point();
         }
-        if self.t > self.params.t_max {
-            return Err(TraceOutcome::Miss { steps });
-        }
-        Ok(self.ray.at(self.t))
+        let t = self.prev_t + self.prev_d * self.plain.step_scale;
+        Err(if t > params.t_max {
+            TraceOutcome::Miss { steps }
+        } else {
+            TraceOutcome::GaveUp { t, steps }
+        })
     }
 
     /// Checks the last step and takes the next one from the field's value `d` at
     /// [`RelaxedMarch::next_point`]; the outcome if that ends the march.
     #[inline]
     fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
-        let (t, params) = (self.t, &self.params);
-        self.steps += 1;
-        let steps = self.steps;
+        let (t, params) = (self.plain.t, &self.plain.params);
+        self.plain.steps += 1;
+        let steps = self.plain.steps;
         if d.is_nan() {
             return Some(TraceOutcome::GaveUp { t, steps });
         }
@@ -393,7 +374,7 @@ impl March for RelaxedMarch {
             self.unchecked = false;
             // Written so that a NaN sum also fails (and takes the safe path).
             if !(self.prev_d + d - 2.0 * eps >= self.last_step) {
-                self.t = self.prev_t + self.prev_d * self.step_scale;
+                self.plain.t = self.prev_t + self.prev_d * self.plain.step_scale;
                 self.last_step = self.prev_d;
                 return None;
             }
@@ -409,7 +390,7 @@ impl March for RelaxedMarch {
         } else {
             1.0
         };
-        let safe = d * self.step_scale;
+        let safe = d * self.plain.step_scale;
         let relaxed = t + omega * safe;
         let next = if omega > 1.0 && relaxed <= params.t_max {
             self.unchecked = true;
@@ -423,7 +404,7 @@ impl March for RelaxedMarch {
             return Some(TraceOutcome::GaveUp { t, steps });
         }
         (self.prev_t, self.prev_d) = (t, d);
-        self.t = next;
+        self.plain.t = next;
         None
     }
 }
