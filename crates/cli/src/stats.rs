@@ -22,12 +22,11 @@ pub fn print_stats(out: &RenderOutput) {
     let film = s.film_time.as_secs_f64();
     let shares = time_shares(secs * threads as f64, tracing, film);
     println!(
-        "time on {threads} thread{}: tracing {:.0}%  shading, normals and sampling {:.0}%  film {:.1}%  (tracing timed on 1 ray in {})",
+        "time on {threads} thread{}: tracing {:.0}%  shading, normals and sampling {:.0}%  film {:.1}%  (tracing timed per stream of rays)",
         if threads == 1 { "" } else { "s" },
         shares[0],
         shares[1],
         shares[2],
-        lueur_integrator::TIMED_EVERY,
     );
     for (name, c) in [
         ("camera", &s.rays.camera),

@@ -3,14 +3,12 @@
 //! per-ray field of candidate objects, bounding-sphere culling) and the
 //! plain union every speed-up is checked against.
 
-use std::cell::Cell;
-
 use glam::Vec3;
 use lueur_sdf_math::{
-    Aabb, DistanceField, HalfSpace, OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClip, Sdf,
-    TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed,
+    Aabb, DistanceField, HalfSpace, Lane, LaneDistance, LaneKernel, LaneVec3, MAX_LANES,
+    OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClipLanes, Sdf, SimdLevel, StreamField,
+    TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed_stream_of,
 };
-use smallvec::SmallVec;
 
 use lueur_scene::{Marching, Object};
 
@@ -29,6 +27,11 @@ pub(crate) struct Geometry {
     always: Vec<usize>,
     /// The other objects with their bounding spheres, in scene order.
     culled: Vec<Bounded>,
+    /// The order fast marching evaluates a ray's candidates in, the same for every ray
+    /// (so that a ray's march does not depend on the rays beside it in a vector): the
+    /// objects checked without their box first, so that the running minimum is small
+    /// when the boxes are checked, then the others, each group in scene order.
+    order: Vec<u32>,
 }
 
 /// What a ray is clipped against for one object (see [`Marching::Fast`]).
@@ -56,92 +59,271 @@ impl ObjectBound {
     }
 }
 
-/// One object a ray may hit, and from where along it. Small, so that a ray's list is
-/// cheap to build, sort and move.
-#[derive(Clone, Copy, Debug)]
-struct Candidate {
-    object: u32,
-    t0: f32,
-}
-
-/// The union of the objects one ray can hit ([`Marching::Fast`]), nearest entry first, and
-/// which of them the last evaluation found nearest.
+/// The rays of one stream that fast marching marches, each with the objects its bounds
+/// let it meet ([`Marching::Fast`]): the union of those objects is the field its march
+/// evaluates, and the object that field last found nearest is the one hit.
 ///
-/// Sphere tracing this field finds the same surface as tracing the whole union: an object
+/// Sphere tracing that union finds the same surface as tracing the whole union: an object
 /// left out has no point within the hit threshold on the marched range (its bound's
 /// contract, [`Aabb::hit_interval`]), so the whole union's march could not stop on it
 /// either, and the objects kept are evaluated exactly. Steps are longer, since the objects
 /// left out no longer shorten them: that is the point.
-struct RayField<'a> {
+///
+/// Buffers are kept from one stream to the next, so that a thread allocates them once.
+#[derive(Debug, Default)]
+pub(crate) struct MarchBatch {
+    /// The rays queued, with their parameters and the caller's tag for each.
+    queued: Vec<(usize, Ray, TraceParams)>,
+    /// The tags of the queued rays that meet no candidate: misses in zero steps.
+    misses: Vec<usize>,
+    /// Per marched ray: the ray, its parameters clipped to the range its candidates
+    /// cover, and its tag.
+    rays: Vec<Ray>,
+    params: Vec<TraceParams>,
+    tags: Vec<usize>,
+    /// Per marched ray, its candidates: `spans[i]` indexes `candidates`, which holds
+    /// positions in [`Geometry::order`].
+    spans: Vec<(u32, u32)>,
+    candidates: Vec<u32>,
+    /// Per marched ray, after [`Geometry::march`]: the outcome, and the object nearest
+    /// at its last evaluation.
+    outcomes: Vec<TraceOutcome>,
+    nearest: Vec<u32>,
+    /// Per lane and position in the order, while clipping: the lane's candidates.
+    clipped: Vec<u32>,
+}
+
+impl MarchBatch {
+    /// Empties the batch for a new stream.
+    pub fn clear(&mut self) {
+        self.queued.clear();
+        self.misses.clear();
+        self.rays.clear();
+        self.params.clear();
+        self.tags.clear();
+        self.spans.clear();
+        self.candidates.clear();
+        self.outcomes.clear();
+        self.nearest.clear();
+    }
+
+    /// Queues `ray`, traced with `params`, under `tag`.
+    pub fn queue(&mut self, tag: usize, ray: Ray, params: TraceParams) {
+        self.queued.push((tag, ray, params));
+    }
+
+    /// After [`Geometry::march`], each queued ray's tag, outcome and object hit (`None` on
+    /// a miss), the rays that met no candidate first.
+    pub fn results(&self) -> impl Iterator<Item = (usize, TraceOutcome, Option<usize>)> + '_ {
+        let misses = (self.misses.iter()).map(|&tag| (tag, TraceOutcome::Miss { steps: 0 }, None));
+        let marched = self.tags.iter().zip(&self.outcomes).zip(&self.nearest).map(
+            |((&tag, &outcome), &nearest)| {
+                let object = match outcome {
+                    TraceOutcome::Miss { .. } => None,
+                    TraceOutcome::Hit { .. } | TraceOutcome::GaveUp { .. } => {
+                        Some(nearest as usize)
+                    }
+                };
+                (tag, outcome, object)
+            },
+        );
+        misses.chain(marched)
+    }
+}
+
+/// The kernel that clips the queued rays of a [`MarchBatch`] against every object's bound,
+/// a ray per lane, and keeps each ray's candidates and the range they cover.
+struct Clip<'a> {
     geometry: &'a Geometry,
-    candidates: SmallVec<[Candidate; 16]>,
-    nearest: Cell<u32>,
+    batch: &'a mut MarchBatch,
 }
 
-impl<'a> RayField<'a> {
-    /// The candidates of `ray` and the range of `t` to march, `None` when no object can be
-    /// hit.
-    fn new(geometry: &'a Geometry, ray: &Ray, params: &TraceParams) -> (Self, Option<(f32, f32)>) {
-        let mut candidates = SmallVec::new();
-        let mut range: Option<(f32, f32)> = None;
-        let clip = RayClip::new(ray, params);
-        for (object, bound) in geometry.bounds.iter().enumerate() {
-            let interval = match bound {
-                ObjectBound::Box { aabb, .. } => clip.clip_box(aabb),
-                ObjectBound::HalfSpace(h) => clip.clip_half_space(h),
-                ObjectBound::Everywhere => Some((params.t_min, params.t_max)),
-            };
-            let Some((t0, t1)) = interval else {
-                continue;
-            };
-            range = Some(range.map_or((t0, t1), |(a, b)| (a.min(t0), b.max(t1))));
-            candidates.push(Candidate {
-                object: object as u32,
-                t0,
-            });
+impl LaneKernel for Clip<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let Clip { geometry, batch } = self;
+        let lanes = L::LANES.min(MAX_LANES);
+        let objects = geometry.order.len();
+        let mut clipped = std::mem::take(&mut batch.clipped);
+        clipped.resize(lanes * objects, 0);
+        let mut start = 0;
+        while start < batch.queued.len() {
+            let group = start..(start + lanes).min(batch.queued.len());
+            start = group.end;
+            let mut v = [[0f32; MAX_LANES]; 10];
+            for (lane, (_, ray, p)) in batch.queued[group.clone()].iter().enumerate() {
+                let values = [
+                    ray.origin.x,
+                    ray.origin.y,
+                    ray.origin.z,
+                    ray.dir.x,
+                    ray.dir.y,
+                    ray.dir.z,
+                    p.eps_abs,
+                    p.eps_rel,
+                    p.t_min,
+                    p.t_max,
+                ];
+                for (row, value) in v.iter_mut().zip(values) {
+                    row[lane] = value;
+                }
+            }
+            let row = |i: usize| -> &[f32] { &v[i][..lanes] };
+            let (t_min, t_max) = (L::load(row(8)), L::load(row(9)));
+            let clip = RayClipLanes::from_lanes(
+                LaneVec3::new(L::load(row(0)), L::load(row(1)), L::load(row(2))),
+                LaneVec3::new(L::load(row(3)), L::load(row(4)), L::load(row(5))),
+                [L::load(row(6)), L::load(row(7)), t_min, t_max],
+            );
+            let (mut count, mut range) = ([0usize; MAX_LANES], [None::<(f32, f32)>; MAX_LANES]);
+            let (mut t0s, mut t1s, mut kept) =
+                ([0f32; MAX_LANES], [0f32; MAX_LANES], [0f32; MAX_LANES]);
+            for (k, &object) in geometry.order.iter().enumerate() {
+                let (t0, t1, keep) = match &geometry.bounds[object as usize] {
+                    ObjectBound::Box { aabb, .. } => clip.clip_box_lanes(aabb),
+                    ObjectBound::HalfSpace(h) => clip.clip_half_space_lanes(h),
+                    ObjectBound::Everywhere => (t_min, t_max, L::splat(0.0).lt(L::splat(1.0))),
+                };
+                t0.store(&mut t0s[..lanes]);
+                t1.store(&mut t1s[..lanes]);
+                L::select(keep, L::splat(1.0), L::splat(0.0)).store(&mut kept[..lanes]);
+                for lane in 0..group.len() {
+                    if kept[lane] != 0.0 {
+                        let (t0, t1) = (t0s[lane], t1s[lane]);
+                        range[lane] =
+                            Some(range[lane].map_or((t0, t1), |(a, b)| (a.min(t0), b.max(t1))));
+                        clipped[lane * objects + count[lane]] = k as u32;
+                        count[lane] += 1;
+                    }
+                }
+            }
+            for (lane, &(tag, ray, params)) in batch.queued[group].iter().enumerate() {
+                let Some((t_min, t_max)) = range[lane] else {
+                    batch.misses.push(tag);
+                    continue;
+                };
+                let first = batch.candidates.len() as u32;
+                let own = &clipped[lane * objects..lane * objects + count[lane]];
+                batch.candidates.extend_from_slice(own);
+                batch.spans.push((first, batch.candidates.len() as u32));
+                batch.rays.push(ray);
+                batch.params.push(TraceParams {
+                    t_min,
+                    t_max,
+                    ..params
+                });
+                batch.tags.push(tag);
+            }
         }
-        // Nearest first: the running minimum is small early, so later boxes cull.
-        candidates.sort_unstable_by(|a: &Candidate, b: &Candidate| a.t0.total_cmp(&b.t0));
-        let field = RayField {
+        batch.clipped = clipped;
+    }
+}
+
+/// The field of each lane's ray in a [`MarchBatch`]: per lane, the union of its ray's
+/// candidates, evaluated in the fixed order [`Geometry::order`] whatever the ray, so that
+/// a lane's value and nearest object do not depend on the other lanes; an object is
+/// evaluated for the whole vector when any lane needs it, and counts only in those.
+struct CandidateLanes<'a> {
+    geometry: &'a Geometry,
+    spans: &'a [(u32, u32)],
+    candidates: &'a [u32],
+    nearest: &'a mut [u32],
+    /// Per lane, the ray it marches.
+    lane_ray: [Option<usize>; MAX_LANES],
+    /// Per position in the order: which lanes' rays have that object as a candidate (1 or
+    /// 0, loaded as a vector), and how many.
+    member: Vec<[f32; MAX_LANES]>,
+    members: Vec<u32>,
+    /// Per lane: its ray's first candidate, the nearest object before any is evaluated,
+    /// and the nearest object at its last evaluation (object indices, exact in f32).
+    first: [f32; MAX_LANES],
+    last: [f32; MAX_LANES],
+}
+
+impl<'a> CandidateLanes<'a> {
+    fn new(
+        geometry: &'a Geometry,
+        batch: &'a mut MarchBatch,
+    ) -> (Self, &'a [Ray], &'a [TraceParams], &'a mut [TraceOutcome]) {
+        let n = batch.rays.len();
+        batch.outcomes.clear();
+        batch.outcomes.resize(n, TraceOutcome::Miss { steps: 0 });
+        batch.nearest.clear();
+        batch.nearest.resize(n, 0);
+        let lanes = CandidateLanes {
             geometry,
-            candidates,
-            nearest: Cell::new(0),
+            spans: &batch.spans,
+            candidates: &batch.candidates,
+            nearest: &mut batch.nearest,
+            lane_ray: [None; MAX_LANES],
+            member: vec![[0.0; MAX_LANES]; geometry.order.len()],
+            members: vec![0; geometry.order.len()],
+            first: [0.0; MAX_LANES],
+            last: [0.0; MAX_LANES],
         };
-        (field, range)
+        (lanes, &batch.rays, &batch.params, &mut batch.outcomes)
     }
 
-    /// The object the last evaluation found nearest: after a hit, the one that was hit.
-    fn nearest(&self) -> usize {
-        self.nearest.get() as usize
+    fn ray_candidates(&self, ray: usize) -> &'a [u32] {
+        let (a, b) = self.spans[ray];
+        &self.candidates[a as usize..b as usize]
     }
 }
 
-impl DistanceField for RayField<'_> {
-    #[inline]
-    fn distance(&self, p: Vec3) -> f32 {
-        let mut d = f32::INFINITY;
-        let mut nearest = self.candidates.first().map_or(0, |c| c.object);
-        for c in &self.candidates {
-            // The box is at most as far as the object (its contract): when it is already
-            // farther than the running minimum, the object cannot lower it.
-            if let ObjectBound::Box { aabb, cull: true } = &self.geometry.bounds[c.object as usize]
-                && d > 0.0
-                && aabb.distance_squared(p) >= d * d
-            {
-                continue;
-            }
-            let f = self.geometry.prepared[c.object as usize].distance(p);
-            if f < d {
-                d = f;
-                nearest = c.object;
-            }
-        }
-        self.nearest.set(nearest);
-        d
-    }
-
+impl StreamField for CandidateLanes<'_> {
     fn lipschitz(&self) -> f32 {
         self.geometry.lipschitz
+    }
+
+    fn assign(&mut self, lane: usize, ray: Option<usize>) {
+        if let Some(old) = self.lane_ray[lane] {
+            self.nearest[old] = self.last[lane] as u32;
+            for &k in self.ray_candidates(old) {
+                self.member[k as usize][lane] = 0.0;
+                self.members[k as usize] -= 1;
+            }
+        }
+        self.lane_ray[lane] = ray;
+        if let Some(ray) = ray {
+            let candidates = self.ray_candidates(ray);
+            for &k in candidates {
+                self.member[k as usize][lane] = 1.0;
+                self.members[k as usize] += 1;
+            }
+            // A marched ray has at least one candidate.
+            self.first[lane] = self.geometry.order[candidates[0] as usize] as f32;
+        }
+    }
+
+    #[inline(always)]
+    fn distance_lanes<L: Lane>(&mut self, p: LaneVec3<L>) -> L {
+        let lanes = L::LANES.min(MAX_LANES);
+        let zero = L::splat(0.0);
+        let mut d = L::splat(f32::INFINITY);
+        let mut nearest = L::load(&self.first[..lanes]);
+        for (k, &object) in self.geometry.order.iter().enumerate() {
+            if self.members[k] == 0 {
+                continue;
+            }
+            let mut active = L::load(&self.member[k][..lanes]).gt(zero);
+            // The box is at most as far as the object (its contract): where it is already
+            // farther than the running minimum, the object cannot lower it.
+            if let ObjectBound::Box { aabb, cull: true } = &self.geometry.bounds[object as usize] {
+                let beyond = L::and(d.gt(zero), aabb.distance_squared_lanes(p).ge(d * d));
+                active = L::and(active, L::not(beyond));
+                if !L::any(active) {
+                    continue;
+                }
+            }
+            let f = self.geometry.prepared[object as usize].distance_lanes(p);
+            let lower = L::and(active, f.lt(d));
+            d = L::select(lower, f, d);
+            nearest = L::select(lower, L::splat(object as f32), nearest);
+        }
+        nearest.store(&mut self.last[..lanes]);
+        d
     }
 }
 
@@ -171,13 +353,20 @@ impl Geometry {
                 _ => always.push(object),
             }
         }
+        let bounds: Vec<ObjectBound> = objects.iter().map(|o| ObjectBound::of(&o.sdf)).collect();
+        let boxed = |b: &ObjectBound| matches!(b, ObjectBound::Box { cull: true, .. });
+        let order = (0..objects.len() as u32)
+            .filter(|&i| !boxed(&bounds[i as usize]))
+            .chain((0..objects.len() as u32).filter(|&i| boxed(&bounds[i as usize])))
+            .collect();
         Geometry {
             sdfs: objects.iter().map(|o| o.sdf.clone()).collect(),
             lipschitz,
-            bounds: objects.iter().map(|o| ObjectBound::of(&o.sdf)).collect(),
+            bounds,
             prepared: objects.iter().map(|o| PreparedSdf::new(&o.sdf)).collect(),
             always,
             culled,
+            order,
         }
     }
 
@@ -241,23 +430,40 @@ impl Geometry {
                 (outcome, object)
             }
             Marching::Fast => {
-                let (field, range) = RayField::new(self, ray, params);
-                let Some((t_min, t_max)) = range else {
-                    return (TraceOutcome::Miss { steps: 0 }, None);
-                };
-                let clipped = TraceParams {
-                    t_min,
-                    t_max,
-                    ..*params
-                };
-                let outcome = sphere_trace_relaxed(&field, ray, &clipped, OVER_RELAXATION);
-                let object = match outcome {
-                    TraceOutcome::Miss { .. } => None,
-                    TraceOutcome::Hit { .. } | TraceOutcome::GaveUp { .. } => Some(field.nearest()),
-                };
+                let mut batch = MarchBatch::default();
+                batch.queue(0, *ray, *params);
+                self.march(SimdLevel::Scalar, &mut batch);
+                let (_, outcome, object) = batch.results().next().expect("one ray was marched");
                 (outcome, object)
             }
         }
+    }
+
+    /// Clips every ray queued in `batch` against the objects' bounds and marches those
+    /// that meet a candidate through their candidates by over-relaxed sphere tracing, on
+    /// `level`'s vectors (a level this CPU lacks runs on the widest it has): the same
+    /// outcome and object for each ray on every level and in any company.
+    pub fn march(&self, level: SimdLevel, batch: &mut MarchBatch) {
+        let level = if level.is_available() {
+            level
+        } else {
+            SimdLevel::detect()
+        };
+        // The level is available: checked above.
+        let _ = level.dispatch(Clip {
+            geometry: self,
+            batch,
+        });
+        let (mut field, rays, params, outcomes) = CandidateLanes::new(self, batch);
+        // The level is available: checked above.
+        let _ = sphere_trace_relaxed_stream_of(
+            level,
+            &mut field,
+            rays,
+            params,
+            OVER_RELAXATION,
+            outcomes,
+        );
     }
 
     /// Object `i`'s field as fast marching evaluates it (its transforms folded).

@@ -67,5 +67,5 @@ pub use render::{
     Pass, PixelBounds, RenderOutput, RenderStats, render, render_pass, render_pass_in,
 };
 pub use replicates::PixelEstimate;
-pub use scene::PreparedScene;
-pub use trace::{Hit, STEP_BUCKETS, TIMED_EVERY, TraceCounters};
+pub use scene::{Execution, PreparedScene};
+pub use trace::{Hit, STEP_BUCKETS, TraceCounters};

@@ -1,15 +1,19 @@
-//! The path-tracing estimator of one pixel sample: the loop that strings the
-//! stages together (intersect, emission, delta lights, scatter, roulette).
-//! Each stage is a function of its inputs only, so that a tracer of batches
-//! of rays can call the same stages on many paths at once.
+//! The path-tracing estimator of pixel samples: a wave of paths advanced a
+//! vertex at a time through the stages (intersect, emission, shading with
+//! its shadow rays, scatter, roulette), each ray kind traced as one stream.
+//! Each stage is a function of one path's inputs only, so a path's estimate
+//! does not depend on the paths beside it.
 
 use glam::Vec3;
 use lueur_materials::Material;
 use lueur_sampling::Sampler;
 use lueur_sdf_math::Ray;
 
+use lueur_sdf_math::TraceParams;
+
 use crate::strategy::{self, EmissionWeight, Lighting, Scatter, Vertex, VertexSample};
 use crate::surface::{March, SurfaceHit, SurfacePoint};
+use crate::trace::{PathRay, ShadowRay, TraceScratch, Tracing};
 use lueur_scene::RenderSettings;
 
 use crate::{Hit, PreparedScene, TraceCounters};
@@ -72,121 +76,250 @@ impl Previous {
     }
 }
 
-/// What one path estimate needs besides its random numbers.
+/// What path estimates need besides their random numbers.
 pub(crate) struct Estimator<'a> {
     pub scene: &'a PreparedScene,
     pub settings: &'a RenderSettings,
     pub march: March,
+    pub tracing: Tracing,
 }
 
 /// Which sample of which pixel a path belongs to.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct SampleId {
     pub pixel: [u32; 2],
     pub index: u32,
 }
 
-/// Radiance arriving along `ray`, estimated by one path.
-pub(crate) fn radiance(
+/// One path in flight: the ray it traces next and what it has gathered.
+#[derive(Clone, Copy)]
+struct Path {
+    ray: Ray,
+    params: TraceParams,
+    beta: Vec3,
+    radiance: Vec3,
+    previous: Previous,
+    /// Scattering events so far.
+    depth: u32,
+}
+
+/// A path shaded at a vertex, waiting for its shadow rays: the vertex, the shadow rays'
+/// contributions (`shadow` indexes the wave's shadow rays; the next-event ray, if any, is
+/// the last), and where the path goes next.
+struct Shaded {
+    path: usize,
+    surface: SurfacePoint,
+    diffuse: bool,
+    shadow: (usize, usize),
+    next_event: bool,
+    scatter: Option<Scatter>,
+    roulette: f32,
+}
+
+/// A thread's buffers for [`radiance_wave`], kept from one wave to the next.
+#[derive(Default)]
+pub(crate) struct WaveScratch {
+    paths: Vec<Path>,
+    active: Vec<usize>,
+    rays: Vec<PathRay>,
+    hits: Vec<Option<Hit>>,
+    shaded: Vec<Shaded>,
+    shadow_rays: Vec<ShadowRay>,
+    contributions: Vec<Vec3>,
+    free: Vec<bool>,
+    trace: TraceScratch,
+    lights: Vec<(ShadowRay, Vec3)>,
+}
+
+/// Radiance arriving along each of `camera_rays` (sample `ids[i]` for ray `i`), estimated
+/// by one path each, into `out` (cleared first).
+///
+/// The paths advance together, a vertex at a time: their rays are traced as one stream,
+/// then each is shaded, then their shadow rays are traced as another stream, then each
+/// gathers what its shadow rays bring and scatters. Every path does exactly what it
+/// would do alone (the stages are functions of the path's own inputs, and each path adds
+/// to its estimate in the same order), so an estimate does not depend on which paths
+/// share its wave, nor on the instruction set the streams run on.
+pub(crate) fn radiance_wave(
     estimator: &Estimator<'_>,
-    mut ray: Ray,
+    camera_rays: &[Ray],
+    ids: &[SampleId],
     sampler: &mut Sampler,
-    id: SampleId,
     counters: &mut RayCounters,
-) -> Vec3 {
+    scratch: &mut WaveScratch,
+    out: &mut Vec<Vec3>,
+) {
     let Estimator {
         scene,
         settings,
         march,
+        tracing,
     } = *estimator;
     let lighting = Lighting::of(scene, settings, &march);
-    let mut radiance = Vec3::ZERO;
-    let mut beta = Vec3::ONE;
-    let mut previous = Previous::camera(ray.origin);
-    let mut depth = 0u32;
-    let mut params = march.camera;
-    loop {
+    let s = scratch;
+    s.paths.clear();
+    s.paths.extend(camera_rays.iter().map(|&ray| Path {
+        ray,
+        params: march.camera,
+        beta: Vec3::ONE,
+        radiance: Vec3::ZERO,
+        previous: Previous::camera(ray.origin),
+        depth: 0,
+    }));
+    s.active.clear();
+    s.active.extend(0..s.paths.len());
+    while !s.active.is_empty() {
+        s.rays.clear();
+        s.rays.extend(s.active.iter().map(|&i| {
+            let path = &s.paths[i];
+            PathRay {
+                ray: path.ray,
+                from: path.previous.p,
+                params: path.params,
+                maybe_inside: path.depth == 0 && march.camera_inside || path.previous.in_solid,
+            }
+        }));
+        // Every path in flight has scattered as often as the others.
+        let depth = s.paths[s.active[0]].depth;
         let kind = counters.path_ray(depth);
-        let maybe_inside = depth == 0 && march.camera_inside || previous.in_solid;
-        let hit = scene.intersect_leaving(
-            &ray,
-            previous.p,
-            &params,
-            march.marching,
-            kind,
-            maybe_inside,
-        );
-        let Some(on_surface) = SurfaceHit::of(hit) else {
-            radiance += emission_found(&lighting, &previous, &ray, hit, beta);
-            break;
-        };
-        if depth >= settings.max_depth {
-            break;
-        }
-        let surface = SurfacePoint::at_hit(scene, &march, &ray, on_surface);
-        let vertex = Vertex {
-            at: surface,
-            wo: -ray.dir,
-            material: scene.scene().materials[scene.scene().objects[on_surface.object].material],
-        };
-        let u = VertexSample::draw(sampler, id.pixel, id.index, depth);
+        scene.intersect_rays(&s.rays, tracing, kind, &mut s.trace, &mut s.hits);
 
-        let through = (beta, &mut radiance);
-        let scatter = shade(
-            &lighting,
-            settings,
-            &vertex,
-            &u,
-            through,
+        s.shaded.clear();
+        s.shadow_rays.clear();
+        s.contributions.clear();
+        for (&i, &hit) in s.active.iter().zip(&s.hits) {
+            let path = &mut s.paths[i];
+            let Some(on_surface) = SurfaceHit::of(hit) else {
+                path.radiance +=
+                    emission_found(&lighting, &path.previous, &path.ray, hit, path.beta);
+                continue;
+            };
+            if path.depth >= settings.max_depth {
+                continue;
+            }
+            let surface = SurfacePoint::at_hit(scene, &march, &path.ray, on_surface);
+            let material =
+                scene.scene().materials[scene.scene().objects[on_surface.object].material];
+            let vertex = Vertex {
+                at: surface,
+                wo: -path.ray.dir,
+                material,
+            };
+            let id = ids[i];
+            let u = VertexSample::draw(sampler, id.pixel, id.index, path.depth);
+            let first = s.shadow_rays.len();
+            let (diffuse, next_event, scatter) = match material {
+                Material::Mirror { .. } => (false, false, strategy::mirror(&vertex, u.bsdf)),
+                Material::Lambertian { .. } => {
+                    s.lights.clear();
+                    lighting.delta_lights(&vertex, &mut s.lights);
+                    let nee = strategy::uses_next_event(settings.strategy)
+                        .then(|| lighting.next_event(&vertex, &u))
+                        .flatten();
+                    let next_event = nee.is_some();
+                    for (ray, contribution) in s.lights.drain(..).chain(nee) {
+                        s.shadow_rays.push(ray);
+                        s.contributions.push(contribution);
+                    }
+                    let scatter =
+                        strategy::scatter(settings.strategy, &lighting.emitters, &vertex, &u);
+                    (true, next_event, scatter)
+                }
+            };
+            s.shaded.push(Shaded {
+                path: i,
+                surface,
+                diffuse,
+                shadow: (first, s.shadow_rays.len()),
+                next_event,
+                scatter,
+                roulette: u.roulette,
+            });
+        }
+        scene.unoccluded_rays(
+            &s.shadow_rays,
+            &lighting.params,
+            tracing,
             &mut counters.shadow,
+            &mut s.trace,
+            &mut s.free,
         );
-        let Some(scatter) = scatter else {
-            break;
-        };
 
-        beta *= scatter.weight;
-        depth += 1;
-        if beta == Vec3::ZERO || !beta.is_finite() {
-            break;
-        }
-        previous = Previous {
-            in_solid: surface.inside && (depth == 1 && march.camera_inside || previous.in_solid),
-            p: surface.p,
-            n: surface.n,
-            emission: scatter.emission,
-        };
-        ray = Ray::new(surface.origin, scatter.wi);
-        params = march.secondary;
-
-        match roulette(beta, depth, settings.roulette_depth, u.roulette) {
-            Some(survivor) => beta = survivor,
-            None => break,
+        s.active.clear();
+        for shaded in &s.shaded {
+            let path = &mut s.paths[shaded.path];
+            if shaded.diffuse {
+                gather(path, shaded, &s.contributions, &s.free, settings);
+            }
+            if scatter(path, shaded, &march, settings) {
+                s.active.push(shaded.path);
+            }
         }
     }
-    radiance
+    out.clear();
+    out.extend(s.paths.iter().map(|p| p.radiance));
 }
 
-/// Adds to `radiance` the light a vertex gathers by shadow rays (delta
-/// lights, and next-event estimation where the strategy uses it), times
-/// the path's throughput `beta`; gives the direction the path scatters in:
-/// the material's for a mirror, the strategy's at a diffuse vertex.
-fn shade(
-    lighting: &Lighting<'_>,
+/// Adds to the path's estimate what its shadow rays bring: the delta lights' sum, then
+/// next-event estimation where the strategy uses it, each times the throughput.
+fn gather(
+    path: &mut Path,
+    shaded: &Shaded,
+    contributions: &[Vec3],
+    free: &[bool],
     settings: &RenderSettings,
-    vertex: &Vertex,
-    u: &VertexSample,
-    (beta, radiance): (Vec3, &mut Vec3),
-    shadow: &mut TraceCounters,
-) -> Option<Scatter> {
-    match vertex.material {
-        Material::Mirror { .. } => strategy::mirror(vertex, u.bsdf),
-        Material::Lambertian { .. } => {
-            *radiance += beta * lighting.delta_lights(vertex, shadow);
-            if strategy::uses_next_event(settings.strategy) {
-                *radiance += beta * lighting.next_event(vertex, u, shadow);
-            }
-            strategy::scatter(settings.strategy, &lighting.emitters, vertex, u)
+) {
+    let (first, end) = shaded.shadow;
+    let delta_end = if shaded.next_event { end - 1 } else { end };
+    let mut delta = Vec3::ZERO;
+    for k in first..delta_end {
+        if free[k] {
+            delta += contributions[k];
         }
+    }
+    path.radiance += path.beta * delta;
+    if strategy::uses_next_event(settings.strategy) {
+        let nee = if shaded.next_event && free[end - 1] {
+            contributions[end - 1]
+        } else {
+            Vec3::ZERO
+        };
+        path.radiance += path.beta * nee;
+    }
+}
+
+/// Moves the path past its vertex in the scattered direction, through Russian roulette;
+/// whether it goes on.
+fn scatter(path: &mut Path, shaded: &Shaded, march: &March, settings: &RenderSettings) -> bool {
+    let Some(scatter) = shaded.scatter else {
+        return false;
+    };
+    path.beta *= scatter.weight;
+    path.depth += 1;
+    if path.beta == Vec3::ZERO || !path.beta.is_finite() {
+        return false;
+    }
+    let surface = &shaded.surface;
+    path.previous = Previous {
+        in_solid: surface.inside
+            && (path.depth == 1 && march.camera_inside || path.previous.in_solid),
+        p: surface.p,
+        n: surface.n,
+        emission: scatter.emission,
+    };
+    path.ray = Ray::new(surface.origin, scatter.wi);
+    path.params = march.secondary;
+    match roulette(
+        path.beta,
+        path.depth,
+        settings.roulette_depth,
+        shaded.roulette,
+    ) {
+        Some(survivor) => {
+            path.beta = survivor;
+            true
+        }
+        None => false,
     }
 }
 

@@ -9,10 +9,11 @@ use lueur_sampling::Sampler;
 use rayon::prelude::*;
 
 use crate::film::{Film, PixelStats};
-use crate::path::{Estimator, RayCounters, SampleId, radiance};
+use crate::path::{Estimator, RayCounters, SampleId, WaveScratch, radiance_wave};
 use crate::replicates::BlockCounter;
 use crate::strategy::CAMERA_DIMS;
 use crate::surface::March;
+use crate::trace::Tracing;
 use lueur_scene::{RenderError, RenderSettings};
 
 use crate::PreparedScene;
@@ -208,6 +209,10 @@ pub fn render_pass_in(
         scene,
         settings,
         march: March::new(scene, settings),
+        tracing: Tracing {
+            marching: settings.marching,
+            simd: scene.execution().simd,
+        },
     };
     let tiles_x = w.div_ceil(TILE);
     let tiles: Vec<UVec2> = (0..h.div_ceil(TILE))
@@ -282,6 +287,42 @@ struct TileCost {
     film_time: Duration,
 }
 
+/// A tile's statistics as its estimates arrive, pixel after pixel and in sample order
+/// within a pixel.
+struct TileSink {
+    /// Per dyadic block of the pass, the tile's finished pixels over it.
+    blocks: Vec<Vec<PixelStats>>,
+    /// The blocks of the pixel being filled.
+    counter: BlockCounter,
+    pixel: Option<[u32; 2]>,
+    dropped: u64,
+}
+
+impl TileSink {
+    fn push(&mut self, id: SampleId, l: glam::Vec3) {
+        if self.pixel != Some(id.pixel) {
+            self.end_pixel();
+            self.pixel = Some(id.pixel);
+        }
+        if !l.is_finite() {
+            self.dropped += 1;
+        }
+        self.counter.push(id.index, PixelStats::of_sample(l));
+    }
+
+    /// Moves the pixel being filled, if any, to the blocks.
+    fn end_pixel(&mut self) {
+        if self.pixel.take().is_none() {
+            return;
+        }
+        debug_assert_eq!(self.counter.blocks().count(), self.blocks.len());
+        for (block, (_, slots)) in self.blocks.iter_mut().zip(self.counter.blocks()) {
+            block.extend_from_slice(slots);
+        }
+        self.counter.clear();
+    }
+}
+
 /// The tile at `origin` of the film of `bounds`; `None` when cancelled.
 fn render_tile(
     estimator: &Estimator<'_>,
@@ -307,43 +348,59 @@ fn render_tile(
         settings.spp,
         replicates,
     );
-    let mut counters = RayCounters::default();
-    let mut dropped = 0u64;
     let block_count = pass_blocks.len();
-    let mut blocks = vec![Vec::with_capacity((tw * th * replicates) as usize); block_count];
-    let mut counter = BlockCounter::new(replicates);
-    for y in origin.y..origin.y + th {
-        for x in origin.x..origin.x + tw {
-            if cancel.load(Ordering::Relaxed) {
-                return None;
-            }
-            counter.clear();
-            for index in samples.clone() {
-                let id = SampleId {
-                    pixel: [x, y],
-                    index,
-                };
-                sampler.start_pixel_sample(id.pixel, index, 0);
-                let jitter = sampler.next_2d();
-                debug_assert_eq!(CAMERA_DIMS, 2);
-                let film_point = glam::Vec2::new(x as f32, y as f32) + jitter;
-                let ray = estimator
-                    .scene
-                    .scene()
-                    .camera
-                    .generate_ray(film_point, w, h);
-                let l = radiance(estimator, ray, &mut sampler, id, &mut counters);
-                if !l.is_finite() {
-                    dropped += 1;
-                }
-                counter.push(index, PixelStats::of_sample(l));
-            }
-            debug_assert_eq!(counter.blocks().count(), block_count);
-            for (block, (_, slots)) in blocks.iter_mut().zip(counter.blocks()) {
-                block.extend_from_slice(slots);
-            }
+    let mut tile = TileSink {
+        blocks: vec![Vec::with_capacity((tw * th * replicates) as usize); block_count],
+        counter: BlockCounter::new(replicates),
+        pixel: None,
+        dropped: 0,
+    };
+    let mut counters = RayCounters::default();
+    let wave = estimator.scene.execution().wave.max(1);
+    let (mut ids, mut rays) = (Vec::with_capacity(wave), Vec::with_capacity(wave));
+    let (mut estimates, mut scratch) = (Vec::with_capacity(wave), WaveScratch::default());
+    let camera = &estimator.scene.scene().camera;
+    let pixels =
+        (origin.y..origin.y + th).flat_map(|y| (origin.x..origin.x + tw).map(move |x| [x, y]));
+    let mut pixel_samples = pixels
+        .flat_map(|pixel| samples.clone().map(move |index| SampleId { pixel, index }))
+        .peekable();
+    while pixel_samples.peek().is_some() {
+        if cancel.load(Ordering::Relaxed) {
+            return None;
+        }
+        ids.clear();
+        rays.clear();
+        for id in pixel_samples.by_ref().take(wave) {
+            sampler.start_pixel_sample(id.pixel, id.index, 0);
+            let jitter = sampler.next_2d();
+            debug_assert_eq!(CAMERA_DIMS, 2);
+            let film_point = glam::Vec2::new(id.pixel[0] as f32, id.pixel[1] as f32) + jitter;
+            rays.push(camera.generate_ray(film_point, w, h));
+            ids.push(id);
+        }
+        radiance_wave(
+            estimator,
+            &rays,
+            &ids,
+            &mut sampler,
+            &mut counters,
+            &mut scratch,
+            &mut estimates,
+        );
+        for (id, &l) in ids.iter().zip(&estimates) {
+            tile.push(*id, l);
         }
     }
+    tile.end_pixel();
+    debug_assert!(
+        tile.blocks
+            .iter()
+            .all(|b| b.len() == (tw * th * replicates) as usize)
+    );
+    let TileSink {
+        blocks, dropped, ..
+    } = tile;
     Some(TileResult {
         width: tw,
         height: th,

@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use lueur_scene::{Marching, QuadSampling, Scene};
-use lueur_sdf_math::{PreparedSdf, Ray};
+use lueur_sdf_math::{PreparedSdf, Ray, SimdLevel};
 
 use crate::geometry::Geometry;
 use crate::light_sampler::{Emitters, LightSampler};
@@ -21,6 +21,34 @@ pub struct PreparedScene {
     /// The choice among the lights and the sky that light sampling aims at.
     light_sampler: LightSampler,
     scale: f32,
+    execution: Execution,
+}
+
+/// How renders of a scene run on this machine, which never changes an image: the
+/// instruction set the ray streams run on, and how many paths advance together.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Execution {
+    /// The vectors of fast marching's streams; a level this CPU lacks runs on the widest
+    /// it has ([`SimdLevel::detect`]).
+    pub simd: SimdLevel,
+    /// Paths per wave (at least 1): enough to keep a vector's lanes busy while paths
+    /// end, few enough that a wave's rays stay in cache.
+    pub wave: usize,
+}
+
+impl Execution {
+    /// Paths per wave by default: 16 vectors of the widest lanes, measured against 64 and
+    /// 1024 in docs/PERFORMANCE.md.
+    pub const WAVE: usize = 256;
+}
+
+impl Default for Execution {
+    fn default() -> Execution {
+        Execution {
+            simd: SimdLevel::detect(),
+            wave: Execution::WAVE,
+        }
+    }
 }
 
 impl PreparedScene {
@@ -34,7 +62,18 @@ impl PreparedScene {
             geometry,
             light_sampler,
             scale,
+            execution: Execution::default(),
         }
+    }
+
+    /// The same scene, rendered as `execution` says.
+    pub fn with_execution(self, execution: Execution) -> PreparedScene {
+        PreparedScene { execution, ..self }
+    }
+
+    /// How renders of this scene run.
+    pub fn execution(&self) -> Execution {
+        self.execution
     }
 
     /// The scene this was prepared from.

@@ -13,9 +13,10 @@ use lueur_sdf_math::{Ray, TraceParams};
 
 use crate::light_sampler::Emitters;
 use crate::surface::{March, SurfacePoint};
-use lueur_scene::{Marching, RenderSettings, Strategy};
+use lueur_scene::{RenderSettings, Strategy};
 
-use crate::{PreparedScene, TraceCounters};
+use crate::PreparedScene;
+use crate::trace::ShadowRay;
 
 /// Sampler dimensions consumed per path vertex, so that each bounce reads
 /// the same dimensions whatever happened before (low-discrepancy point sets
@@ -254,7 +255,6 @@ pub(crate) struct Lighting<'a> {
     pub scene: &'a PreparedScene,
     pub emitters: Emitters<'a>,
     pub params: TraceParams,
-    pub marching: Marching,
 }
 
 impl<'a> Lighting<'a> {
@@ -265,15 +265,14 @@ impl<'a> Lighting<'a> {
             scene,
             emitters: scene.emitters(settings.quad_sampling),
             params: march.secondary,
-            marching: march.marching,
         }
     }
 
-    /// Light from every delta light, by a shadow ray each (a delta light can
-    /// be reached no other way).
-    pub fn delta_lights(&self, v: &Vertex, shadow: &mut TraceCounters) -> Vec3 {
+    /// The light every delta light would bring, with the shadow ray each needs (a delta
+    /// light can be reached no other way), pushed to `out` in the lights' order; the
+    /// vertex gathers the sum of those whose ray is free, in that order.
+    pub fn delta_lights(&self, v: &Vertex, out: &mut Vec<(ShadowRay, Vec3)>) {
         let (n, wo) = (v.at.n, v.wo);
-        let mut sum = Vec3::ZERO;
         for light in &self.scene.scene().lights {
             let Some((wi, irradiance)) = light.delta_arrival() else {
                 continue;
@@ -286,47 +285,37 @@ impl<'a> Lighting<'a> {
             if f == Vec3::ZERO {
                 continue;
             }
-            let ray = Ray::new(v.at.origin, wi);
-            if self.scene.unoccluded(
-                &ray,
-                f32::INFINITY,
-                None,
-                &self.params,
-                self.marching,
-                shadow,
-            ) {
-                sum += f * irradiance * cos;
-            }
+            let ray = ShadowRay {
+                ray: Ray::new(v.at.origin, wi),
+                distance: f32::INFINITY,
+                target: None,
+            };
+            out.push((ray, f * irradiance * cos));
         }
-        sum
     }
 
-    /// Next-event estimation toward one chosen emitter, weighted against
-    /// `mis`'s BSDF sampling by [`next_event_weight`].
-    pub fn next_event(&self, v: &Vertex, u: &VertexSample, shadow: &mut TraceCounters) -> Vec3 {
+    /// Next-event estimation toward one chosen emitter, weighted against `mis`'s BSDF
+    /// sampling by [`next_event_weight`]: what it brings if its shadow ray is free, with
+    /// that ray; `None` where it brings nothing whatever the ray finds.
+    pub fn next_event(&self, v: &Vertex, u: &VertexSample) -> Option<(ShadowRay, Vec3)> {
         let (n, wo) = (v.at.n, v.wo);
-        let Some((es, light)) = self.emitters.sample(v.at.p, n, u.emitter_choice, u.emitter) else {
-            return Vec3::ZERO;
-        };
+        let (es, light) = self
+            .emitters
+            .sample(v.at.p, n, u.emitter_choice, u.emitter)?;
         let f = v.material.eval(wo, es.wi, n);
         let cos = n.dot(es.wi).abs();
         if f == Vec3::ZERO || cos == 0.0 || es.radiance == Vec3::ZERO {
-            return Vec3::ZERO;
+            return None;
         }
-        let (shadow_ray, distance) = v.at.shadow_ray(es.wi, es.distance);
-        if !self.scene.unoccluded(
-            &shadow_ray,
-            distance,
-            light,
-            &self.params,
-            self.marching,
-            shadow,
-        ) {
-            return Vec3::ZERO;
-        }
+        let (ray, distance) = v.at.shadow_ray(es.wi, es.distance);
         let bsdf_pdf = v.material.pdf(wo, es.wi, n, MIS_HEMISPHERE);
         let w = next_event_weight(es.pdf, bsdf_pdf);
-        f * es.radiance * cos * w / es.pdf
+        let ray = ShadowRay {
+            ray,
+            distance,
+            target: light,
+        };
+        Some((ray, f * es.radiance * cos * w / es.pdf))
     }
 }
 

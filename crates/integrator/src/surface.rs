@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 use lueur_sdf_math::{
-    DistanceField, FALLBACK_NORMAL, PreparedSdf, Ray, TraceParams, gradient, gradient_central,
-    position_rounding,
+    DistanceField, FALLBACK_NORMAL, LaneDistance, PreparedSdf, Ray, TraceParams, gradient_central,
+    gradient_lanes, position_rounding,
 };
 
 use lueur_scene::{Marching, RenderSettings};
@@ -199,7 +199,7 @@ impl SurfacePoint {
     /// different depths of the shell. Along the ray, the shading point is
     /// the ray's own intersection (to second order) wherever the tracer
     /// stopped, and the normal is taken there.
-    fn new<F: DistanceField>(
+    fn new<F: DistanceField + LaneDistance>(
         sdf: &F,
         hit: Vec3,
         wo: Vec3,
@@ -237,7 +237,7 @@ impl SurfacePoint {
         let grad = if march.central_normals {
             gradient_central(sdf, start, h)
         } else {
-            gradient(sdf, start, h)
+            gradient_lanes(sdf, start, h)
         };
         let g = grad.length();
         let n_geo = if g.is_finite() && g > 0.0 {

@@ -5,11 +5,12 @@ use std::time::Instant;
 
 use glam::Vec3;
 
-use lueur_sdf_math::{DistanceField, Ray, TraceOutcome, TraceParams, sphere_trace};
+use lueur_sdf_math::{DistanceField, Ray, SimdLevel, TraceOutcome, TraceParams, sphere_trace};
 
 use lueur_scene::Marching;
 
 use crate::PreparedScene;
+use crate::geometry::MarchBatch;
 
 /// What a ray found first.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,17 +57,13 @@ pub struct TraceCounters {
     /// `2^i ..= 2^(i+1) - 1` steps (bucket 0 also counts rays of 0 steps,
     /// the last one every ray of 512 steps or more).
     pub steps_histogram: [u64; STEP_BUCKETS],
-    /// Rays whose tracing was timed: one in [`TIMED_EVERY`], so that the
-    /// clock (tens of nanoseconds a reading) costs well under 1% of a render.
+    /// Rays traced by the timed streams (every stream is timed as a whole: the clock,
+    /// tens of nanoseconds a reading, is read twice per stream of many rays).
     pub timed_rays: u64,
     /// Wall time spent tracing the timed rays (bounds, marching, lights), in
     /// nanoseconds. Never affects the image.
     pub timed_nanos: u64,
 }
-
-/// One ray in this many is timed (see [`TraceCounters::timed_nanos`]); a
-/// power of two.
-pub const TIMED_EVERY: u64 = 16;
 
 /// Buckets of [`TraceCounters::steps_histogram`].
 pub const STEP_BUCKETS: usize = 10;
@@ -94,20 +91,11 @@ impl TraceCounters {
         self.timed_nanos as f64 * 1e-9 * self.rays as f64 / self.timed_rays as f64
     }
 
-    /// Starts the clock if this ray is one of the timed ones (decided by
-    /// the ray count, so deterministically and evenly spread).
-    #[inline]
-    fn clock(&self) -> Option<Instant> {
-        // A mask, not `is_multiple_of` (Rust 1.87; the workspace supports 1.85).
-        (self.rays & (TIMED_EVERY - 1) == 0).then(Instant::now)
-    }
-
-    #[inline]
-    fn stop(&mut self, clock: Option<Instant>) {
-        if let Some(start) = clock {
-            self.timed_rays += 1;
-            self.timed_nanos += start.elapsed().as_nanos() as u64;
-        }
+    /// Adds the time of a stream that started at `start` and traced the rays counted
+    /// since `rays_before`.
+    fn timed(&mut self, start: Instant, rays_before: u64) {
+        self.timed_rays += self.rays - rays_before;
+        self.timed_nanos += start.elapsed().as_nanos() as u64;
     }
 
     /// Adds another set of counters.
@@ -125,6 +113,44 @@ impl TraceCounters {
     }
 }
 
+/// A ray a path traces to its next vertex.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PathRay {
+    /// The ray the objects are marched along (its origin lifted off the last surface).
+    pub ray: Ray,
+    /// The point the ray leaves (the camera, or the last shading point), from which the
+    /// lights, which are exact, are intersected.
+    pub from: Vec3,
+    pub params: TraceParams,
+    /// Whether the ray may start inside a solid ([`PreparedScene::intersect_maybe_inside`]).
+    pub maybe_inside: bool,
+}
+
+/// A shadow ray: is the segment from `ray.origin` along `ray.dir` free of objects and of
+/// lights other than `target` up to `distance`?
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ShadowRay {
+    pub ray: Ray,
+    pub distance: f32,
+    pub target: Option<usize>,
+}
+
+/// How rays are traced: the marching mode, and the instruction set fast marching's
+/// streams run on (every level gives the same bits).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Tracing {
+    pub marching: Marching,
+    pub simd: SimdLevel,
+}
+
+/// A thread's buffers for tracing streams, kept from one stream to the next.
+#[derive(Debug, Default)]
+pub(crate) struct TraceScratch {
+    batch: MarchBatch,
+    /// Per path ray: its parameters as marched, and whether it was marched inside.
+    marched: Vec<(TraceParams, bool)>,
+}
+
 impl PreparedScene {
     /// Finds the first object or light along `ray`.
     pub fn intersect(
@@ -134,7 +160,7 @@ impl PreparedScene {
         marching: Marching,
         counters: &mut TraceCounters,
     ) -> Option<Hit> {
-        self.intersect_leaving(ray, ray.origin, params, marching, counters, false)
+        self.intersect_one(ray, params, marching, counters, false)
     }
 
     /// [`PreparedScene::intersect`] for a ray that may start inside a solid: a
@@ -153,114 +179,182 @@ impl PreparedScene {
         marching: Marching,
         counters: &mut TraceCounters,
     ) -> Option<Hit> {
-        self.intersect_leaving(ray, ray.origin, params, marching, counters, true)
+        self.intersect_one(ray, params, marching, counters, true)
     }
 
-    /// [`PreparedScene::intersect`] (or, with `maybe_inside`, [`PreparedScene::intersect_maybe_inside`])
-    /// for a ray leaving the surface point `from`: the objects are marched from
-    /// `ray.origin`, lifted off the surface so that the march does not stop on it at once,
-    /// but the lights, which are exact, are intersected from `from` itself. So a light is
-    /// seen under the solid angle it has from the point that was shaded, the one next-event
-    /// estimation and the MIS weights use, however far the origin had to be lifted; light
-    /// hits' `t` are measured from `from`.
-    pub(crate) fn intersect_leaving(
+    fn intersect_one(
         &self,
         ray: &Ray,
-        from: Vec3,
         params: &TraceParams,
         marching: Marching,
         counters: &mut TraceCounters,
         maybe_inside: bool,
     ) -> Option<Hit> {
-        let clock = counters.clock();
-        let params = params.resolving(ray.origin);
-        let light_ray = Ray {
-            origin: from,
-            dir: ray.dir,
+        let path_ray = PathRay {
+            ray: *ray,
+            from: ray.origin,
+            params: *params,
+            maybe_inside,
         };
-        let light_hit = self.intersect_lights(&light_ray, params.t_max, None);
-        let t_max = light_hit.map_or(params.t_max, |(t, _)| t);
-        let mut surface = None;
-        if !self.scene().objects.is_empty() {
-            let p = TraceParams { t_max, ..params };
-            let start = ray.at(p.t_min);
-            let inside = maybe_inside
-                && self.distance(start, marching) < -p.eps_abs.max(p.eps_rel * p.t_min);
-            let (outcome, object) = if inside {
-                (sphere_trace(&self.geometry.inside(), ray, &p), None)
-            } else {
-                self.geometry.trace(ray, &p, marching)
-            };
-            counters.record(&outcome);
-            let (t_hit, gave_up) = match outcome {
-                // A ray that reaches the step cap without a decision is crawling along a
-                // surface it is about to meet (inside a closed solid, its wall), so it
-                // stops where it is. Measured on the shipped scenes against a cap 64 times
-                // higher (`cargo xtask scale`, docs/SCALE.md): this changes the Death
-                // Star's image mean by -0.002%, taking it as a miss by -0.23% (it sees the
-                // sky through a wall) and ending the path by -0.37%.
-                TraceOutcome::GaveUp { t, steps } if steps > 0 => (Some(t), true),
-                _ => (outcome.hit_t(), false),
-            };
-            if let Some(t) = t_hit {
-                let object = object.unwrap_or_else(|| self.closest_object(ray.at(t)));
-                let mut epsilon = p.eps_abs.max(p.eps_rel * t);
-                if gave_up {
-                    // One evaluation, on the rare ray that gave up: where it stopped
-                    // may be farther from the surface than a hit threshold.
-                    let f = self.geometry.prepared(object).distance(ray.at(t)).abs();
-                    if f.is_finite() {
-                        epsilon = epsilon.max(f);
-                    }
-                }
-                surface = Some(Hit::Surface {
-                    t,
-                    object,
-                    epsilon,
-                    inside,
-                });
-            }
-        } else {
-            counters.rays += 1;
-        }
-        counters.stop(clock);
-        surface.or(light_hit.map(|(t, light)| Hit::Light { t, light }))
+        let tracing = Tracing {
+            marching,
+            simd: SimdLevel::Scalar,
+        };
+        let mut hits = Vec::with_capacity(1);
+        let scratch = &mut TraceScratch::default();
+        self.intersect_rays(&[path_ray], tracing, counters, scratch, &mut hits);
+        hits[0]
     }
 
-    /// Whether the segment from `ray.origin` along `ray.dir` is free of
-    /// objects and of lights other than `target` up to `distance`.
-    pub(crate) fn unoccluded(
+    /// What each of `rays` finds first, into `hits` (cleared first), as
+    /// [`PreparedScene::intersect`] or [`PreparedScene::intersect_maybe_inside`] find it for
+    /// the ray alone: the objects are marched from `ray.origin`, lifted off the surface
+    /// so that the march does not stop on it at once, but the lights, which are exact,
+    /// are intersected from `from` itself. So a light is seen under the solid angle it has
+    /// from the point that was shaded, the one next-event estimation and the MIS weights
+    /// use, however far the origin had to be lifted; light hits' `t` are measured from
+    /// `from`. Fast marching marches the rays as one stream.
+    pub(crate) fn intersect_rays(
+        &self,
+        rays: &[PathRay],
+        tracing: Tracing,
+        counters: &mut TraceCounters,
+        scratch: &mut TraceScratch,
+        hits: &mut Vec<Option<Hit>>,
+    ) {
+        let (clock, rays_before) = (Instant::now(), counters.rays);
+        hits.clear();
+        scratch.batch.clear();
+        scratch.marched.clear();
+        let has_objects = !self.scene().objects.is_empty();
+        for (i, r) in rays.iter().enumerate() {
+            let params = r.params.resolving(r.ray.origin);
+            let light_ray = Ray {
+                origin: r.from,
+                dir: r.ray.dir,
+            };
+            let light_hit = self.intersect_lights(&light_ray, params.t_max, None);
+            hits.push(light_hit.map(|(t, light)| Hit::Light { t, light }));
+            let p = TraceParams {
+                t_max: light_hit.map_or(params.t_max, |(t, _)| t),
+                ..params
+            };
+            let inside = has_objects
+                && r.maybe_inside
+                && self.distance(r.ray.at(p.t_min), tracing.marching)
+                    < -p.eps_abs.max(p.eps_rel * p.t_min);
+            scratch.marched.push((p, inside));
+            if !has_objects {
+                counters.rays += 1;
+                continue;
+            }
+            let done = if inside {
+                Some((sphere_trace(&self.geometry.inside(), &r.ray, &p), None))
+            } else if tracing.marching == Marching::Naive {
+                Some(self.geometry.trace(&r.ray, &p, Marching::Naive))
+            } else {
+                scratch.batch.queue(i, r.ray, p);
+                None
+            };
+            if let Some((outcome, object)) = done {
+                counters.record(&outcome);
+                let (p, inside) = scratch.marched[i];
+                hits[i] = self
+                    .surface_hit(&r.ray, &p, inside, outcome, object)
+                    .or(hits[i]);
+            }
+        }
+        self.geometry.march(tracing.simd, &mut scratch.batch);
+        for (i, outcome, object) in scratch.batch.results() {
+            counters.record(&outcome);
+            let (p, inside) = scratch.marched[i];
+            hits[i] = self
+                .surface_hit(&rays[i].ray, &p, inside, outcome, object)
+                .or(hits[i]);
+        }
+        counters.timed(clock, rays_before);
+    }
+
+    /// The surface a march of `ray` with parameters `params` found, if any.
+    fn surface_hit(
         &self,
         ray: &Ray,
-        distance: f32,
-        target: Option<usize>,
+        p: &TraceParams,
+        inside: bool,
+        outcome: TraceOutcome,
+        object: Option<usize>,
+    ) -> Option<Hit> {
+        let (t, gave_up) = match outcome {
+            // A ray that reaches the step cap without a decision is crawling along a
+            // surface it is about to meet (inside a closed solid, its wall), so it
+            // stops where it is. Measured on the shipped scenes against a cap 64 times
+            // higher (`cargo xtask scale`, docs/SCALE.md): this changes the Death
+            // Star's image mean by -0.002%, taking it as a miss by -0.23% (it sees the
+            // sky through a wall) and ending the path by -0.37%.
+            TraceOutcome::GaveUp { t, steps } if steps > 0 => (t, true),
+            _ => (outcome.hit_t()?, false),
+        };
+        let object = object.unwrap_or_else(|| self.closest_object(ray.at(t)));
+        let mut epsilon = p.eps_abs.max(p.eps_rel * t);
+        if gave_up {
+            // One evaluation, on the rare ray that gave up: where it stopped
+            // may be farther from the surface than a hit threshold.
+            let f = self.geometry.prepared(object).distance(ray.at(t)).abs();
+            if f.is_finite() {
+                epsilon = epsilon.max(f);
+            }
+        }
+        Some(Hit::Surface {
+            t,
+            object,
+            epsilon,
+            inside,
+        })
+    }
+
+    /// Whether each of `rays` is free, into `free` (cleared first), every ray traced
+    /// with `params`; fast marching marches them as one stream.
+    pub(crate) fn unoccluded_rays(
+        &self,
+        rays: &[ShadowRay],
         params: &TraceParams,
-        marching: Marching,
+        tracing: Tracing,
         counters: &mut TraceCounters,
-    ) -> bool {
-        let clock = counters.clock();
-        let params = &params.resolving(ray.origin);
-        let free = 'free: {
+        scratch: &mut TraceScratch,
+        free: &mut Vec<bool>,
+    ) {
+        let (clock, rays_before) = (Instant::now(), counters.rays);
+        free.clear();
+        scratch.batch.clear();
+        for (i, r) in rays.iter().enumerate() {
+            let params = &params.resolving(r.ray.origin);
             // Stop short of the light's surface so that its own geometry (for
             // lights that are objects too) does not occlude it.
-            let t_max = (distance * (1.0 - 1e-4) - params.eps_abs).min(params.t_max);
-            if let Some((_, l)) = self.intersect_lights(ray, t_max, target)
-                && Some(l) != target
-            {
-                break 'free false;
+            let t_max = (r.distance * (1.0 - 1e-4) - params.eps_abs).min(params.t_max);
+            let blocked = self
+                .intersect_lights(&r.ray, t_max, r.target)
+                .is_some_and(|(_, l)| Some(l) != r.target);
+            free.push(!blocked);
+            if blocked || self.scene().objects.is_empty() || t_max <= params.t_min {
+                continue;
             }
-            if self.scene().objects.is_empty() || t_max <= params.t_min {
-                break 'free true;
+            let p = TraceParams { t_max, ..*params };
+            match tracing.marching {
+                Marching::Naive => {
+                    let outcome = self.geometry.trace(&r.ray, &p, Marching::Naive).0;
+                    counters.record(&outcome);
+                    free[i] = matches!(outcome, TraceOutcome::Miss { .. });
+                }
+                Marching::Fast => scratch.batch.queue(i, r.ray, p),
             }
-            let (outcome, _) =
-                self.geometry
-                    .trace(ray, &TraceParams { t_max, ..*params }, marching);
+        }
+        self.geometry.march(tracing.simd, &mut scratch.batch);
+        for (i, outcome, _) in scratch.batch.results() {
             counters.record(&outcome);
-            // A shadow ray that gives up is taken as a hit too (see `intersect_leaving`).
-            matches!(outcome, TraceOutcome::Miss { .. })
-        };
-        counters.stop(clock);
-        free
+            // A shadow ray that gives up is taken as a hit too (see `surface_hit`).
+            free[i] = matches!(outcome, TraceOutcome::Miss { .. });
+        }
+        counters.timed(clock, rays_before);
     }
 
     fn intersect_lights(&self, ray: &Ray, t_max: f32, skip: Option<usize>) -> Option<(f32, usize)> {

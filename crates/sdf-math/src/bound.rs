@@ -12,8 +12,9 @@
 //! [`Sdf::bounding_box`]: crate::Sdf::bounding_box
 //! [`Sdf::bounding_half_space`]: crate::Sdf::bounding_half_space
 
-use glam::{BVec3A, Vec3, Vec3A};
+use glam::Vec3;
 
+use crate::lanes::{Lane, LaneVec3};
 use crate::{Ray, TraceParams};
 
 /// Relative widening of every interval end: covers the rounding of the slab test itself.
@@ -72,7 +73,16 @@ impl Aabb {
     /// before evaluating a shape, whether it can be nearer than what was already found.
     #[inline]
     pub fn distance_squared(&self, p: Vec3) -> f32 {
-        let outside = (self.min - p).max(p - self.max).max(Vec3::ZERO);
+        self.distance_squared_lanes(LaneVec3::<f32>::from(p))
+    }
+
+    /// [`Aabb::distance_squared`] of each lane's point: the same formula, so each lane
+    /// gives the scalar bits.
+    #[inline(always)]
+    pub fn distance_squared_lanes<L: Lane>(&self, p: LaneVec3<L>) -> L {
+        let outside = (LaneVec3::splat(self.min) - p)
+            .max(p - LaneVec3::splat(self.max))
+            .max(LaneVec3::splat(Vec3::ZERO));
         outside.length_squared()
     }
 
@@ -104,42 +114,54 @@ impl Aabb {
 /// margin guessed from the ray's length: a ray leaving a wall is never a candidate for
 /// that wall (the plane it leaves grows faster than `eps_rel t`), however close it
 /// starts.
+///
+/// Written once over [`Lane`]s, a ray per lane ([`RayClipLanes`]); [`RayClip`] is the
+/// one-ray case, and every lane of a vector gives that ray's bits.
 #[derive(Clone, Copy, Debug)]
-pub struct RayClip {
-    origin: Vec3A,
-    dir: Vec3,
+pub struct RayClipLanes<L: Lane> {
+    origin: LaneVec3<L>,
+    dir: LaneVec3<L>,
     /// The four families of box planes, per axis: faces facing + (value `o - max`, slope
     /// `d`) and facing - (value `min - o`, slope `-d`), each against the absolute and the
     /// relative threshold (slope less `eps_rel`). Slopes are per ray, so their reciprocals
     /// and signs are too.
-    families: [Slope; 4],
+    families: [Slope<L>; 4],
     /// A non-finite origin or direction: every clip keeps the whole range.
-    degenerate: bool,
-    /// The largest coordinate of the origin: the rounding of positions near it.
-    eps_abs: f32,
-    eps_rel: f32,
-    t_min: f32,
-    t_max: f32,
+    degenerate: L::Mask,
+    eps_abs: L,
+    eps_rel: L,
+    t_min: L,
+    t_max: L,
 }
+
+/// One ray prepared for clipping: [`RayClipLanes`] with one lane.
+pub type RayClip = RayClipLanes<f32>;
 
 /// The slope of one family of planes along the ray, per axis.
 #[derive(Clone, Copy, Debug)]
-struct Slope {
+struct Slope<L: Lane> {
     /// `1 / slope`, with a zero slope replaced by a tiny positive one, so that
     /// `a + 0 t < 0` comes out as "every t" for negative `a` and "none" for positive `a`
     /// with no special case.
-    inv: Vec3A,
+    inv: LaneVec3<L>,
     /// Where the slope is positive: the set is `t < root`; elsewhere `t > root`.
-    rising: BVec3A,
+    rising: [L::Mask; 3],
 }
 
-impl Slope {
-    #[inline]
-    fn new(slope: Vec3A) -> Slope {
-        let slope = Vec3A::select(slope.cmpeq(Vec3A::ZERO), Vec3A::splat(1e-30), slope);
+impl<L: Lane> Slope<L> {
+    #[inline(always)]
+    fn new(slope: LaneVec3<L>) -> Slope<L> {
+        // Not closures: a vector kernel inlines only what is marked to be inlined.
+        #[inline(always)]
+        fn per_axis<L: Lane>(s: L) -> (L, L::Mask) {
+            let zero = L::splat(0.0);
+            let s = L::select(L::and(s.ge(zero), L::not(s.gt(zero))), L::splat(1e-30), s);
+            (L::splat(1.0) / s, s.gt(zero))
+        }
+        let ((x, rx), (y, ry), (z, rz)) = (per_axis(slope.x), per_axis(slope.y), per_axis(slope.z));
         Slope {
-            inv: slope.recip(),
-            rising: slope.cmpgt(Vec3A::ZERO),
+            inv: LaneVec3::new(x, y, z),
+            rising: [rx, ry, rz],
         }
     }
 
@@ -147,107 +169,169 @@ impl Slope {
     /// empty one as `(inf, -inf)` so that it drops out of a hull (the hull of a half-line
     /// at negative `t` and one at positive `t` is everything, clipped first it is the
     /// second).
-    #[inline]
-    fn below(&self, alpha: Vec3A, t_min: Vec3A, t_max: Vec3A) -> (Vec3A, Vec3A) {
-        let root = -alpha * self.inv;
-        let lo = Vec3A::select(self.rising, t_min, root.max(t_min));
-        let hi = Vec3A::select(self.rising, root.min(t_max), t_max);
-        let empty = lo.cmpgt(hi);
-        (
-            Vec3A::select(empty, Vec3A::INFINITY, lo),
-            Vec3A::select(empty, Vec3A::NEG_INFINITY, hi),
-        )
+    #[inline(always)]
+    fn below(&self, alpha: LaneVec3<L>, t_min: L, t_max: L) -> (LaneVec3<L>, LaneVec3<L>) {
+        #[inline(always)]
+        fn axis<L: Lane>(alpha: L, inv: L, rising: L::Mask, t_min: L, t_max: L) -> (L, L) {
+            let root = -alpha * inv;
+            let lo = L::select(rising, t_min, root.max_cmp(t_min));
+            let hi = L::select(rising, root.min_cmp(t_max), t_max);
+            let empty = lo.gt(hi);
+            (
+                L::select(empty, L::splat(f32::INFINITY), lo),
+                L::select(empty, L::splat(f32::NEG_INFINITY), hi),
+            )
+        }
+        let (lx, hx) = axis(alpha.x, self.inv.x, self.rising[0], t_min, t_max);
+        let (ly, hy) = axis(alpha.y, self.inv.y, self.rising[1], t_min, t_max);
+        let (lz, hz) = axis(alpha.z, self.inv.z, self.rising[2], t_min, t_max);
+        (LaneVec3::new(lx, ly, lz), LaneVec3::new(hx, hy, hz))
     }
 }
 
-/// Every `t`.
-const ALL: (f32, f32) = (f32::NEG_INFINITY, f32::INFINITY);
-/// No `t` (neutral for a hull).
-const NONE: (f32, f32) = (f32::INFINITY, f32::NEG_INFINITY);
-
 /// `{t : alpha + beta t < 0}`, given `inv = 1 / beta`, as an interval (possibly infinite,
-/// possibly empty as [`NONE`]). A NaN anywhere gives [`ALL`]: keep what is not understood.
-#[inline]
-fn half_line(alpha: f32, beta: f32, inv: f32) -> (f32, f32) {
+/// possibly empty as `(inf, -inf)`). A NaN anywhere gives every `t`: keep what is not
+/// understood.
+#[inline(always)]
+fn half_line<L: Lane>(alpha: L, beta: L, inv: L) -> (L, L) {
+    let (inf, zero) = (L::splat(f32::INFINITY), L::splat(0.0));
     let root = -alpha * inv;
-    if root.is_nan() || beta.is_nan() {
-        ALL
-    } else if beta > 0.0 {
-        (f32::NEG_INFINITY, root)
-    } else if beta < 0.0 {
-        (root, f32::INFINITY)
-    } else if alpha < 0.0 {
-        ALL
-    } else {
-        NONE
-    }
+    let all = L::or(
+        L::or(root.is_nan(), beta.is_nan()),
+        L::and(
+            L::not(beta.gt(zero)),
+            L::and(L::not(beta.lt(zero)), alpha.lt(zero)),
+        ),
+    );
+    let lo = L::select(beta.gt(zero), -inf, L::select(beta.lt(zero), root, inf));
+    let hi = L::select(beta.gt(zero), root, L::select(beta.lt(zero), inf, -inf));
+    (L::select(all, -inf, lo), L::select(all, inf, hi))
 }
 
 /// The hull, within `range`, of the `t` where a plane value `a + b t` is below
-/// `max(eps_abs, eps_rel t)`; [`NONE`] if there are none. Each set is clipped to the range
-/// before the hull is taken, so that a half-line at negative `t` does not drag it to
-/// everything.
-#[inline]
-fn below_threshold(
-    a: f32,
-    eps_abs: f32,
-    (b, inv): (f32, f32),
-    (b_rel, inv_rel): (f32, f32),
-    (t_min, t_max): (f32, f32),
-) -> (f32, f32) {
-    let clip = |(lo, hi): (f32, f32)| {
+/// `max(eps_abs, eps_rel t)`; empty (`(inf, -inf)`) if there are none. Each set is
+/// clipped to the range before the hull is taken, so that a half-line at negative `t`
+/// does not drag it to everything.
+#[inline(always)]
+fn below_threshold<L: Lane>(
+    a: L,
+    eps_abs: L,
+    (b, inv): (L, L),
+    (b_rel, inv_rel): (L, L),
+    (t_min, t_max): (L, L),
+) -> (L, L) {
+    #[inline(always)]
+    fn clip<L: Lane>((lo, hi): (L, L), t_min: L, t_max: L) -> (L, L) {
         let (lo, hi) = (lo.max(t_min), hi.min(t_max));
-        if lo <= hi { (lo, hi) } else { NONE }
-    };
-    let (lo_abs, hi_abs) = clip(half_line(a - eps_abs, b, inv));
-    let (lo_rel, hi_rel) = clip(half_line(a, b_rel, inv_rel));
+        let kept = hi.ge(lo);
+        (
+            L::select(kept, lo, L::splat(f32::INFINITY)),
+            L::select(kept, hi, L::splat(f32::NEG_INFINITY)),
+        )
+    }
+    let (lo_abs, hi_abs) = clip(half_line(a - eps_abs, b, inv), t_min, t_max);
+    let (lo_rel, hi_rel) = clip(half_line(a, b_rel, inv_rel), t_min, t_max);
     (lo_abs.min(lo_rel), hi_abs.max(hi_rel))
+}
+
+/// Widens `[t0, t1]` by a relative [`WIDEN`] and clips it to `[t_min, t_max]`: the
+/// interval, and whether it is not empty.
+#[inline(always)]
+fn widen<L: Lane>(t0: L, t1: L, t_min: L, t_max: L) -> (L, L, L::Mask) {
+    let widen = L::splat(WIDEN);
+    let nan = L::or(t0.is_nan(), t1.is_nan());
+    let w0 = (t0 - widen * t0.abs()).max(t_min);
+    let w1 = (t1 + widen * t1.abs()).min(t_max);
+    let kept = L::and(L::not(t0.gt(t1)), w1.ge(w0));
+    (
+        L::select(nan, t_min, w0),
+        L::select(nan, t_max, w1),
+        L::or(nan, kept),
+    )
 }
 
 impl RayClip {
     /// Prepares `ray` for clipping with the hit thresholds and range of `params`.
     #[inline]
     pub fn new(ray: &Ray, params: &TraceParams) -> RayClip {
-        let eps_rel = params.eps_rel.max(0.0);
-        let d = Vec3A::from(ray.dir);
-        let rel = Vec3A::splat(eps_rel);
-        RayClip {
-            origin: ray.origin.into(),
-            dir: ray.dir,
-            families: [
-                Slope::new(d),
-                Slope::new(d - rel),
-                Slope::new(-d),
-                Slope::new(-d - rel),
-            ],
-            degenerate: !(ray.origin.is_finite() && ray.dir.is_finite()),
-            eps_abs: params.eps_abs.max(0.0),
-            eps_rel,
-            t_min: params.t_min,
-            t_max: params.t_max,
-        }
+        RayClipLanes::from_lanes(
+            ray.origin.into(),
+            ray.dir.into(),
+            [params.eps_abs, params.eps_rel, params.t_min, params.t_max],
+        )
     }
 
     /// [`Aabb::hit_interval`] for this ray: the six faces' intervals intersected (see the
-    /// type), clipped to the trace's range, its ends widened by a relative `1e-5`. Three
-    /// axes at a time (`Vec3A`), with no branch.
+    /// type), clipped to the trace's range, its ends widened by a relative `1e-5`.
     #[inline]
     pub fn clip_box(&self, aabb: &Aabb) -> Option<(f32, f32)> {
-        if self.degenerate {
-            return Some((self.t_min, self.t_max));
+        let (t0, t1, kept) = self.clip_box_lanes(aabb);
+        kept.then_some((t0, t1))
+    }
+
+    /// [`HalfSpace::hit_interval`] for this ray: one plane, whose normal need not be unit
+    /// (the field is at least the plane's value, whatever its scale).
+    #[inline]
+    pub fn clip_half_space(&self, h: &HalfSpace) -> Option<(f32, f32)> {
+        let (t0, t1, kept) = self.clip_half_space_lanes(h);
+        kept.then_some((t0, t1))
+    }
+}
+
+impl<L: Lane> RayClipLanes<L> {
+    /// Prepares a ray per lane for clipping, from their origins, directions and
+    /// `[eps_abs, eps_rel, t_min, t_max]`.
+    #[inline(always)]
+    pub fn from_lanes(
+        origin: LaneVec3<L>,
+        dir: LaneVec3<L>,
+        [eps_abs, eps_rel, t_min, t_max]: [L; 4],
+    ) -> Self {
+        let zero = L::splat(0.0);
+        let eps_rel = eps_rel.max(zero);
+        let rel = LaneVec3::new(eps_rel, eps_rel, eps_rel);
+        #[inline(always)]
+        fn finite<L: Lane>(v: L) -> L::Mask {
+            L::not(L::or(v.is_nan(), (v - v).is_nan()))
         }
-        let (min, max) = (Vec3A::from(aabb.min), Vec3A::from(aabb.max));
+        #[inline(always)]
+        fn all_finite<L: Lane>(v: LaneVec3<L>) -> L::Mask {
+            L::and(finite(v.x), L::and(finite(v.y), finite(v.z)))
+        }
+        RayClipLanes {
+            origin,
+            dir,
+            families: [
+                Slope::new(dir),
+                Slope::new(dir - rel),
+                Slope::new(-dir),
+                Slope::new(-dir - rel),
+            ],
+            degenerate: L::not(L::and(all_finite(origin), all_finite(dir))),
+            eps_abs: eps_abs.max(zero),
+            eps_rel,
+            t_min,
+            t_max,
+        }
+    }
+
+    /// [`RayClip::clip_box`] for each lane's ray: `(t0, t1, kept)`, the interval
+    /// meaningful where `kept`.
+    #[inline(always)]
+    pub fn clip_box_lanes(&self, aabb: &Aabb) -> (L, L, L::Mask) {
+        let (min, max) = (LaneVec3::splat(aabb.min), LaneVec3::splat(aabb.max));
         // Taken off every plane value: the f32 rounding of the numbers that decide it, per
         // axis (the origin's coordinate and the box's faces on that axis). Per axis, not
         // the largest coordinate of all, so that a ray leaving the top of a floor 1e4 wide
         // is not a candidate for it however close above it starts.
-        let rounding =
-            Vec3A::splat(4.0 * f32::EPSILON) * self.origin.abs().max(min.abs()).max(max.abs());
-        let eps_abs = Vec3A::splat(self.eps_abs);
+        let scale = self.origin.abs().max(min.abs()).max(max.abs());
+        let four_eps = L::splat(4.0 * f32::EPSILON);
+        let rounding = LaneVec3::new(four_eps * scale.x, four_eps * scale.y, four_eps * scale.z);
+        let eps_abs = LaneVec3::new(self.eps_abs, self.eps_abs, self.eps_abs);
         let up = self.origin - max - rounding;
         let down = min - self.origin - rounding;
         let [up_abs, up_rel, down_abs, down_rel] = &self.families;
-        let (t_min, t_max) = (Vec3A::splat(self.t_min), Vec3A::splat(self.t_max));
+        let (t_min, t_max) = (self.t_min, self.t_max);
         let (lo_a, hi_a) = up_abs.below(up - eps_abs, t_min, t_max);
         let (lo_b, hi_b) = up_rel.below(up, t_min, t_max);
         let (lo_c, hi_c) = down_abs.below(down - eps_abs, t_min, t_max);
@@ -255,25 +339,33 @@ impl RayClip {
         // Per face the hull of its two sets; over the faces, the intersection.
         let lo = lo_a.min(lo_b).max(lo_c.min(lo_d));
         let hi = hi_a.max(hi_b).min(hi_c.max(hi_d));
-        let t0 = lo.max_element().max(self.t_min);
-        let t1 = hi.min_element().min(self.t_max);
-        widen(t0, t1, self.t_min, self.t_max)
+        let t0 = lo.max_element().max(t_min);
+        let t1 = hi.min_element().min(t_max);
+        let (t0, t1, kept) = widen(t0, t1, t_min, t_max);
+        (
+            L::select(self.degenerate, t_min, t0),
+            L::select(self.degenerate, t_max, t1),
+            L::or(self.degenerate, kept),
+        )
     }
 
-    /// [`HalfSpace::hit_interval`] for this ray: one plane, whose normal need not be unit
-    /// (the field is at least the plane's value, whatever its scale).
-    #[inline]
-    pub fn clip_half_space(&self, h: &HalfSpace) -> Option<(f32, f32)> {
-        let terms = h.normal.abs() * Vec3::from(self.origin.abs());
-        let rounding = 4.0 * f32::EPSILON * (terms.element_sum() + h.height.abs());
-        let a = h.value(self.origin.into()) - rounding;
-        let b = self.dir.dot(h.normal);
+    /// [`RayClip::clip_half_space`] for each lane's ray, as [`RayClipLanes::clip_box_lanes`].
+    #[inline(always)]
+    pub fn clip_half_space_lanes(&self, h: &HalfSpace) -> (L, L, L::Mask) {
+        let normal = LaneVec3::splat(h.normal);
+        let o = self.origin.abs();
+        let n = h.normal.abs();
+        let terms = L::splat(n.x) * o.x + L::splat(n.y) * o.y + L::splat(n.z) * o.z;
+        let rounding = L::splat(4.0 * f32::EPSILON) * (terms + L::splat(h.height.abs()));
+        let a = self.origin.dot(normal) - L::splat(h.height) - rounding;
+        let b = self.dir.dot(normal);
         let b_rel = b - self.eps_rel;
+        let one = L::splat(1.0);
         let (t0, t1) = below_threshold(
             a,
             self.eps_abs,
-            (b, b.recip()),
-            (b_rel, b_rel.recip()),
+            (b, one / b),
+            (b_rel, one / b_rel),
             (self.t_min, self.t_max),
         );
         widen(t0, t1, self.t_min, self.t_max)
@@ -306,20 +398,6 @@ impl HalfSpace {
     pub fn hit_interval(&self, ray: &Ray, params: &TraceParams) -> Option<(f32, f32)> {
         RayClip::new(ray, params).clip_half_space(self)
     }
-}
-
-/// Widens `[t0, t1]` by a relative [`WIDEN`] and clips it to `[t_min, t_max]`.
-#[inline]
-fn widen(t0: f32, t1: f32, t_min: f32, t_max: f32) -> Option<(f32, f32)> {
-    if t0.is_nan() || t1.is_nan() {
-        return Some((t_min, t_max));
-    }
-    if t0 > t1 {
-        return None;
-    }
-    let t0 = (t0 - WIDEN * t0.abs()).max(t_min);
-    let t1 = (t1 + WIDEN * t1.abs()).min(t_max);
-    (t0 <= t1).then_some((t0, t1))
 }
 
 #[cfg(test)]

@@ -54,6 +54,7 @@ mod normal;
 mod prepared;
 mod primitives;
 mod ray;
+mod relaxed;
 mod sdf;
 mod sdf_bounds;
 mod stream;
@@ -62,20 +63,22 @@ mod trace;
 pub use glam::{Quat, Vec3};
 
 pub use crate::blend::{smooth_max, smooth_min};
-pub use crate::bound::{Aabb, HalfSpace, RayClip};
+pub use crate::bound::{Aabb, HalfSpace, RayClip, RayClipLanes};
 pub use crate::field::DistanceField;
 pub use crate::lanes::{
     Avx2, Avx512, Isa, Lane, LaneDistance, LaneKernel, LaneVec3, Neon, Portable, SimdLevel, Sse,
     Task, UnavailableLevel, Wide,
 };
-pub use crate::normal::{FALLBACK_NORMAL, gradient, gradient_central, normal, normal_central};
+pub use crate::normal::{
+    FALLBACK_NORMAL, gradient, gradient_central, gradient_lanes, normal, normal_central,
+};
 pub use crate::prepared::PreparedSdf;
 pub use crate::primitives::Primitive;
 pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
 pub use crate::stream::{
-    sphere_trace_relaxed_stream, sphere_trace_relaxed_stream_at, sphere_trace_stream,
-    sphere_trace_stream_at,
+    MAX_LANES, StreamField, sphere_trace_relaxed_stream, sphere_trace_relaxed_stream_at,
+    sphere_trace_relaxed_stream_of, sphere_trace_stream, sphere_trace_stream_at,
 };
 pub use crate::trace::{
     HIT_ULPS, OVER_RELAXATION, TraceOutcome, TraceParams, position_rounding, sphere_trace,

@@ -110,7 +110,8 @@ fn affine_coordinate<L: Lane>(p: LaneVec3<L>, row: Vec3, t: f32) -> L {
 
 /// The one definition of the prepared field: the affine map, the tree, the factor.
 impl LaneDistance for PreparedSdf {
-    #[inline]
+    // Always: a vector kernel that calls it must compile it for its own instruction set.
+    #[inline(always)]
     fn distance_lanes<L: Lane>(&self, p: LaneVec3<L>) -> L {
         L::splat(self.factor) * self.shape.distance_lanes(self.local(p))
     }

@@ -14,13 +14,48 @@
 //! scalar one (the lane contract), and the march around it is the same code.
 
 use crate::lanes::{Lane, LaneDistance, LaneKernel, LaneVec3, SimdLevel, UnavailableLevel};
-use crate::trace::{HartMarch, March, RelaxedMarch};
+use crate::relaxed::{RelaxedLanes, point_at, status};
+use crate::trace::{HartMarch, March, RelaxedMarch, outcome};
 #[cfg(doc)]
 use crate::trace::{sphere_trace, sphere_trace_relaxed};
 use crate::{DistanceField, Ray, TraceOutcome, TraceParams, Vec3};
 
 /// The widest vector of any [`SimdLevel`].
-const MAX_LANES: usize = 16;
+pub const MAX_LANES: usize = 16;
+
+/// A field a stream of rays is marched through that may differ from ray to ray (each ray
+/// with the objects its bounds let it meet, say), evaluated for a vector of rays at once.
+///
+/// Contract: the value of each lane is what the field of that lane's ray gives at its
+/// point, bit for bit the same whichever lane, vector width or company the ray has, so
+/// that a ray's march does not depend on how the stream was cut into vectors.
+pub trait StreamField {
+    /// A Lipschitz bound of every ray's field: it sets each ray's step.
+    fn lipschitz(&self) -> f32;
+    /// Lane `lane` (below [`MAX_LANES`]) marches ray `ray` of the stream from now on, or
+    /// idles (`None`) until the next call for it.
+    fn assign(&mut self, lane: usize, ray: Option<usize>);
+    /// The field of each lane's ray at that lane's point; idle lanes' values are never
+    /// read.
+    fn distance_lanes<L: Lane>(&mut self, p: LaneVec3<L>) -> L;
+}
+
+/// One field for every ray of a stream.
+struct Shared<'a, F: ?Sized>(&'a F);
+
+impl<F: LaneDistance + DistanceField + ?Sized> StreamField for Shared<'_, F> {
+    fn lipschitz(&self) -> f32 {
+        self.0.lipschitz()
+    }
+
+    #[inline(always)]
+    fn assign(&mut self, _: usize, _: Option<usize>) {}
+
+    #[inline(always)]
+    fn distance_lanes<L: Lane>(&mut self, p: LaneVec3<L>) -> L {
+        self.0.distance_lanes(p)
+    }
+}
 
 /// Traces every ray of `rays` with its `params` through `field` by plain sphere tracing,
 /// writing each outcome to `out`, on the widest path this CPU has.
@@ -53,14 +88,7 @@ pub fn sphere_trace_stream_at<F>(
 where
     F: LaneDistance + DistanceField + ?Sized,
 {
-    check_lengths(rays, params, out);
-    level.dispatch(Stream {
-        field,
-        rays,
-        params,
-        out,
-        start: |ray: &Ray, params: &TraceParams| HartMarch::start(field, ray, params),
-    })
+    sphere_trace_relaxed_stream_of(level, &mut Shared(field), rays, params, 1.0, out)
 }
 
 /// Traces every ray of `rays` with its `params` through `field` by over-relaxed sphere
@@ -98,21 +126,23 @@ pub fn sphere_trace_relaxed_stream_at<F>(
 where
     F: LaneDistance + DistanceField + ?Sized,
 {
-    if !(omega_max > 1.0 && omega_max.is_finite()) {
-        // As `sphere_trace_relaxed` does: no factor above 1 is the plain march.
-        return sphere_trace_stream_at(level, field, rays, params, out);
-    }
-    check_lengths(rays, params, out);
-    level.dispatch(Stream {
-        field,
-        rays,
-        params,
-        out,
-        start: |ray: &Ray, params: &TraceParams| RelaxedMarch::start(field, ray, params, omega_max),
-    })
+    sphere_trace_relaxed_stream_of(level, &mut Shared(field), rays, params, omega_max, out)
 }
 
-fn check_lengths(rays: &[Ray], params: &[TraceParams], out: &[TraceOutcome]) {
+/// [`sphere_trace_relaxed_stream_at`] through a field that may differ per ray: each ray's
+/// outcome is what [`sphere_trace_relaxed`] gives for it through its own field (the plain
+/// march where `omega_max` is not above 1), on every path and for any length of stream.
+///
+/// # Panics
+/// If `rays`, `params` and `out` differ in length.
+pub fn sphere_trace_relaxed_stream_of<F: StreamField>(
+    level: SimdLevel,
+    field: &mut F,
+    rays: &[Ray],
+    params: &[TraceParams],
+    omega_max: f32,
+    out: &mut [TraceOutcome],
+) -> Result<(), UnavailableLevel> {
     assert!(
         rays.len() == params.len() && rays.len() == out.len(),
         "sphere_trace_stream: {} rays, {} parameters, {} outcomes",
@@ -120,11 +150,31 @@ fn check_lengths(rays: &[Ray], params: &[TraceParams], out: &[TraceOutcome]) {
         params.len(),
         out.len()
     );
+    let lipschitz = field.lipschitz();
+    if omega_max > 1.0 && omega_max.is_finite() {
+        level.dispatch(RelaxedStream {
+            field,
+            rays,
+            params,
+            out,
+            lipschitz,
+            omega_max,
+        })
+    } else {
+        // As `sphere_trace_relaxed` does: no factor above 1 is the plain march.
+        level.dispatch(Stream {
+            field,
+            rays,
+            params,
+            out,
+            start: |ray: &Ray, params: &TraceParams| HartMarch::start(lipschitz, ray, params),
+        })
+    }
 }
 
-/// The kernel behind both streams: `start` begins a ray's march.
-struct Stream<'a, F: ?Sized, S> {
-    field: &'a F,
+/// The kernel behind every stream: `start` begins a ray's march.
+struct Stream<'a, F, S> {
+    field: &'a mut F,
     rays: &'a [Ray],
     params: &'a [TraceParams],
     out: &'a mut [TraceOutcome],
@@ -142,30 +192,34 @@ struct InFlight<M> {
 
 impl<F, S, M> Stream<'_, F, S>
 where
-    F: LaneDistance + DistanceField + ?Sized,
+    F: StreamField,
     S: Fn(&Ray, &TraceParams) -> Result<M, TraceOutcome>,
     M: March,
 {
-    /// The next ray of the stream that needs the field at all, from `*next` on; rays that
-    /// end before their first evaluation get their outcome here.
+    /// The next ray of the stream that needs the field at all, from `*next` on, for
+    /// `lane`; rays that end before their first evaluation get their outcome here.
     #[inline(always)]
-    fn take(&mut self, next: &mut usize) -> Option<InFlight<M>> {
+    fn take(&mut self, lane: usize, next: &mut usize) -> Option<InFlight<M>> {
         while *next < self.rays.len() {
             let ray = *next;
             *next += 1;
             let started = (self.start)(&self.rays[ray], &self.params[ray]);
             match started.and_then(|march| Ok((march, march.next_point()?))) {
-                Ok((march, point)) => return Some(InFlight { march, ray, point }),
+                Ok((march, point)) => {
+                    self.field.assign(lane, Some(ray));
+                    return Some(InFlight { march, ray, point });
+                }
                 Err(outcome) => self.out[ray] = outcome,
             }
         }
+        self.field.assign(lane, None);
         None
     }
 }
 
 impl<F, S, M> LaneKernel for Stream<'_, F, S>
 where
-    F: LaneDistance + DistanceField + ?Sized,
+    F: StreamField,
     S: Fn(&Ray, &TraceParams) -> Result<M, TraceOutcome>,
     M: March,
 {
@@ -176,8 +230,8 @@ where
         let lanes = L::LANES.min(MAX_LANES);
         let mut flight: [Option<InFlight<M>>; MAX_LANES] = [None; MAX_LANES];
         let mut next = 0;
-        for slot in flight.iter_mut().take(lanes) {
-            *slot = self.take(&mut next);
+        for (lane, slot) in flight.iter_mut().enumerate().take(lanes) {
+            *slot = self.take(lane, &mut next);
         }
         let (mut xs, mut ys, mut zs) = ([0f32; MAX_LANES], [0f32; MAX_LANES], [0f32; MAX_LANES]);
         let mut d = [0f32; MAX_LANES];
@@ -205,9 +259,141 @@ where
                     Ok(point) => Some(InFlight { point, ..f }),
                     Err(outcome) => {
                         self.out[f.ray] = outcome;
-                        self.take(&mut next)
+                        self.take(lane, &mut next)
                     }
                 };
+            }
+        }
+    }
+}
+
+/// The kernel of the relaxed streams: every lane's march, control included, advances in
+/// one vector step ([`RelaxedLanes`]); a lane whose ray is done takes the next one.
+struct RelaxedStream<'a, F> {
+    field: &'a mut F,
+    rays: &'a [Ray],
+    params: &'a [TraceParams],
+    out: &'a mut [TraceOutcome],
+    lipschitz: f32,
+    omega_max: f32,
+}
+
+/// The rows of a relaxed stream's lane state, one `f32` per lane each.
+const ROWS: usize = 17;
+
+impl<F: StreamField> RelaxedStream<'_, F> {
+    /// Gives `lane` the next ray of the stream that needs the field at all, from `*next`
+    /// on, writing its state into `rows`; rays that end before their first evaluation get
+    /// their outcome here. `None` when the stream is dry: the lane idles.
+    #[inline(always)]
+    fn take(
+        &mut self,
+        lane: usize,
+        next: &mut usize,
+        rows: &mut [[f32; MAX_LANES]; ROWS],
+    ) -> Option<usize> {
+        while *next < self.rays.len() {
+            let ray = *next;
+            *next += 1;
+            let started = RelaxedMarch::start(
+                self.lipschitz,
+                &self.rays[ray],
+                &self.params[ray],
+                self.omega_max,
+            );
+            match started.and_then(|march| march.next_point().map(|_| march)) {
+                Ok(march) => {
+                    let (o, d, s) = (march.ray.origin, march.ray.dir, march.state);
+                    let values = [
+                        o.x,
+                        o.y,
+                        o.z,
+                        d.x,
+                        d.y,
+                        d.z,
+                        s.t,
+                        s.steps,
+                        s.prev_t,
+                        s.prev_d,
+                        s.last_step,
+                        s.unchecked,
+                        s.step_scale,
+                        s.t_max,
+                        s.max_steps,
+                        s.eps_abs,
+                        s.eps_rel,
+                    ];
+                    for (row, value) in rows.iter_mut().zip(values) {
+                        row[lane] = value;
+                    }
+                    self.field.assign(lane, Some(ray));
+                    return Some(ray);
+                }
+                Err(outcome) => self.out[ray] = outcome,
+            }
+        }
+        self.field.assign(lane, None);
+        None
+    }
+}
+
+impl<F: StreamField> LaneKernel for RelaxedStream<'_, F> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lane>(mut self) {
+        let lanes = L::LANES.min(MAX_LANES);
+        let mut rows = [[0f32; MAX_LANES]; ROWS];
+        let mut flight = [None::<usize>; MAX_LANES];
+        let mut next = 0;
+        for (lane, slot) in flight.iter_mut().enumerate().take(lanes) {
+            *slot = self.take(lane, &mut next, &mut rows);
+        }
+        let (mut status, mut t_out) = ([0f32; MAX_LANES], [0f32; MAX_LANES]);
+        while flight[..lanes].iter().any(Option::is_some) {
+            let row = |i: usize| L::load(&rows[i][..lanes]);
+            let origin = LaneVec3::new(row(0), row(1), row(2));
+            let dir = LaneVec3::new(row(3), row(4), row(5));
+            let mut state = RelaxedLanes {
+                t: row(6),
+                steps: row(7),
+                prev_t: row(8),
+                prev_d: row(9),
+                last_step: row(10),
+                unchecked: row(11),
+                step_scale: row(12),
+                t_max: row(13),
+                max_steps: row(14),
+                eps_abs: row(15),
+                eps_rel: row(16),
+            };
+            let d = self.field.distance_lanes(point_at(origin, dir, state.t));
+            let (stepped, t_stepped) = state.advance(d, self.omega_max);
+            let (standing, t_standing) = state.standing();
+            let ended = stepped.gt(L::splat(status::GOING));
+            L::select(ended, stepped, standing).store(&mut status[..lanes]);
+            L::select(ended, t_stepped, t_standing).store(&mut t_out[..lanes]);
+            for (i, v) in [
+                state.t,
+                state.steps,
+                state.prev_t,
+                state.prev_d,
+                state.last_step,
+                state.unchecked,
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                v.store(&mut rows[6 + i][..lanes]);
+            }
+            for lane in 0..lanes {
+                let Some(ray) = flight[lane] else {
+                    continue;
+                };
+                if let Some(outcome) = outcome(status[lane], t_out[lane], rows[7][lane]) {
+                    self.out[ray] = outcome;
+                    flight[lane] = self.take(lane, &mut next, &mut rows);
+                }
             }
         }
     }

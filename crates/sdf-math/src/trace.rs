@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use crate::relaxed::{MAX_STEP_CAP, RelaxedLanes, status};
 use crate::{DistanceField, Ray};
 
 /// The hit threshold is never below this many [`position_rounding`]s of the ray's origin,
@@ -113,8 +114,7 @@ impl TraceOutcome {
 /// direction. A `lipschitz()` that is NaN, zero or negative breaks the
 /// field's contract and is replaced by 1 rather than trusted.
 #[inline]
-fn step_scale<F: DistanceField + ?Sized>(field: &F, ray: &Ray) -> Option<f32> {
-    let lipschitz = field.lipschitz();
+fn step_scale(lipschitz: f32, ray: &Ray) -> Option<f32> {
     let lipschitz = if lipschitz > 0.0 { lipschitz } else { 1.0 };
     let speed = ray.dir.length();
     (speed > 0.0 && speed.is_finite()).then(|| 1.0 / (lipschitz * speed))
@@ -141,7 +141,7 @@ pub fn sphere_trace<F: DistanceField + ?Sized>(
     ray: &Ray,
     params: &TraceParams,
 ) -> TraceOutcome {
-    match HartMarch::start(field, ray, params) {
+    match HartMarch::start(field.lipschitz(), ray, params) {
         Ok(march) => run_to_end(march, field),
         Err(outcome) => outcome,
     }
@@ -189,12 +189,12 @@ pub(crate) struct HartMarch {
 impl HartMarch {
     /// The march of `ray`, or its outcome at once for a zero or non-finite direction.
     #[inline]
-    pub(crate) fn start<F: DistanceField + ?Sized>(
-        field: &F,
+    pub(crate) fn start(
+        lipschitz: f32,
         ray: &Ray,
         params: &TraceParams,
     ) -> Result<HartMarch, TraceOutcome> {
-        match step_scale(field, ray) {
+        match step_scale(lipschitz, ray) {
             Some(step_scale) => Ok(HartMarch {
                 ray: *ray,
                 params: *params,
@@ -254,10 +254,6 @@ impl March for HartMarch {
 /// surface); the check after each step keeps any factor safe.
 pub const OVER_RELAXATION: f32 = 8.0;
 
-/// How close to the planar estimate's limit a relaxed step goes (below 1, so that a
-/// slightly curved surface does not fail every check).
-const RELAXATION_MARGIN: f32 = 0.9;
-
 /// Over-relaxed sphere tracing: steps of `omega * f(p) / L` with `omega >= 1`, each checked
 /// afterwards (Keinert et al. 2014, "Enhanced Sphere Tracing"), with `omega` chosen per step
 /// from the slope of the field along the ray (Balint and Valasek 2018, "Accelerating
@@ -295,27 +291,21 @@ pub fn sphere_trace_relaxed<F: DistanceField + ?Sized>(
     if !(omega_max > 1.0 && omega_max.is_finite()) {
         return sphere_trace(field, ray, params);
     }
-    match RelaxedMarch::start(field, ray, params, omega_max) {
+    match RelaxedMarch::start(field.lipschitz(), ray, params, omega_max) {
         Ok(march) => run_to_end(march, field),
         Err(outcome) => outcome,
     }
 }
 
 /// One ray's over-relaxed sphere trace as a state machine, as [`HartMarch`] is for the
-/// plain one: [`sphere_trace_relaxed`] drives it one ray at a time and
-/// `stream::sphere_trace_relaxed_stream` many rays a lane each.
+/// plain one: [`sphere_trace_relaxed`] drives it one ray at a time; its state and step are
+/// the one-lane instance of [`RelaxedLanes`], which the relaxed streams run for a vector
+/// of rays at once.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct RelaxedMarch {
-    /// The ray, its parameters and step scale, the current `t` and the steps spent.
-    plain: HartMarch,
-    omega_max: f32,
-    /// The previous sample and its field value; the step from it to `t` in field units
-    /// (`omega * prev_d`, 0 before the first step); whether that step was relaxed and so
-    /// must pass the check before `t` is trusted.
-    prev_t: f32,
-    prev_d: f32,
-    last_step: f32,
-    unchecked: bool,
+    pub ray: Ray,
+    pub omega_max: f32,
+    pub state: RelaxedLanes<f32>,
 }
 
 impl RelaxedMarch {
@@ -323,89 +313,68 @@ impl RelaxedMarch {
     /// the plain march is the one to run), or its outcome at once for a zero or non-finite
     /// direction.
     #[inline]
-    pub(crate) fn start<F: DistanceField + ?Sized>(
-        field: &F,
+    pub(crate) fn start(
+        lipschitz: f32,
         ray: &Ray,
         params: &TraceParams,
         omega_max: f32,
     ) -> Result<RelaxedMarch, TraceOutcome> {
-        HartMarch::start(field, ray, params).map(|plain| RelaxedMarch {
-            plain,
+        let Some(step_scale) = step_scale(lipschitz, ray) else {
+            return Err(TraceOutcome::GaveUp {
+                t: params.t_min,
+                steps: 0,
+            });
+        };
+        Ok(RelaxedMarch {
+            ray: *ray,
             omega_max,
-            prev_t: params.t_min,
-            prev_d: 0.0,
-            last_step: 0.0,
-            unchecked: false,
+            state: RelaxedLanes {
+                t: params.t_min,
+                steps: 0.0,
+                prev_t: params.t_min,
+                prev_d: 0.0,
+                last_step: 0.0,
+                unchecked: 0.0,
+                step_scale,
+                t_max: params.t_max,
+                max_steps: params.max_steps.min(MAX_STEP_CAP) as f32,
+                eps_abs: params.eps_abs,
+                eps_rel: params.eps_rel,
+            },
         })
     }
 }
 
+/// The outcome a lane's `status` and `t` stand for, after `steps` evaluations; `None`
+/// while the march goes on.
+#[inline(always)]
+pub(crate) fn outcome(status: f32, t: f32, steps: f32) -> Option<TraceOutcome> {
+    let steps = steps as u32;
+    if status == status::HIT {
+        Some(TraceOutcome::Hit { t, steps })
+    } else if status == status::MISS {
+        Some(TraceOutcome::Miss { steps })
+    } else if status == status::GAVE_UP {
+        Some(TraceOutcome::GaveUp { t, steps })
+    } else {
+        None
+    }
+}
+
 impl March for RelaxedMarch {
-    /// The point to evaluate next, or the outcome if the march is over, as for the plain
-    /// march, except that at the step cap a relaxed step not yet checked is taken back to
-    /// the safe one, so a `GaveUp` reports a checked point (only plain steps cross
-    /// `t_max`, so a miss is declared from one).
     #[inline]
     fn next_point(&self) -> Result<Vec3, TraceOutcome> {
-        let HartMarch { params, steps, .. } = self.plain;
-        if !(self.unchecked && steps >= params.max_steps) {
-            return self.plain.next_point();
+        let (status, t) = self.state.standing();
+        match outcome(status, t, self.state.steps) {
+            Some(outcome) => Err(outcome),
+            None => Ok(self.ray.at(t)),
         }
-        let t = self.prev_t + self.prev_d * self.plain.step_scale;
-        Err(if t > params.t_max {
-            TraceOutcome::Miss { steps }
-        } else {
-            TraceOutcome::GaveUp { t, steps }
-        })
     }
 
-    /// Checks the last step and takes the next one from the field's value `d` at
-    /// [`RelaxedMarch::next_point`]; the outcome if that ends the march.
     #[inline]
     fn advance(&mut self, d: f32) -> Option<TraceOutcome> {
-        let (t, params) = (self.plain.t, &self.plain.params);
-        self.plain.steps += 1;
-        let steps = self.plain.steps;
-        if d.is_nan() {
-            return Some(TraceOutcome::GaveUp { t, steps });
-        }
-        let eps = params.eps_abs.max(params.eps_rel * t);
-        if self.unchecked {
-            self.unchecked = false;
-            // Written so that a NaN sum also fails (and takes the safe path).
-            if !(self.prev_d + d - 2.0 * eps >= self.last_step) {
-                self.plain.t = self.prev_t + self.prev_d * self.plain.step_scale;
-                self.last_step = self.prev_d;
-                return None;
-            }
-        }
-        if d < eps {
-            return Some(TraceOutcome::Hit { t, steps });
-        }
-        let omega = if self.last_step > 0.0 {
-            let k = ((d - self.prev_d) / self.last_step).clamp(-1.0, 1.0);
-            // 1 - k = 0 gives +inf, clamped to omega_max; a NaN k (infinite distances)
-            // gives a NaN omega, which takes the plain step below.
-            (RELAXATION_MARGIN * (2.0 - 2.0 * eps / d) / (1.0 - k)).clamp(1.0, self.omega_max)
-        } else {
-            1.0
-        };
-        let safe = d * self.plain.step_scale;
-        let relaxed = t + omega * safe;
-        let next = if omega > 1.0 && relaxed <= params.t_max {
-            self.unchecked = true;
-            self.last_step = omega * d;
-            relaxed
-        } else {
-            self.last_step = d;
-            t + safe
-        };
-        if next == t {
-            return Some(TraceOutcome::GaveUp { t, steps });
-        }
-        (self.prev_t, self.prev_d) = (t, d);
-        self.plain.t = next;
-        None
+        let (status, t) = self.state.advance(d, self.omega_max);
+        outcome(status, t, self.state.steps)
     }
 }
 

@@ -63,8 +63,18 @@ pub trait Lane:
     fn lt(self, other: Self) -> Self::Mask;
     /// `self > other`, per lane.
     fn gt(self, other: Self) -> Self::Mask;
+    /// `self >= other`, per lane.
+    fn ge(self, other: Self) -> Self::Mask;
     /// `self.is_nan()`, per lane.
     fn is_nan(self) -> Self::Mask;
+    /// Both masks, per lane.
+    fn and(a: Self::Mask, b: Self::Mask) -> Self::Mask;
+    /// Either mask, per lane.
+    fn or(a: Self::Mask, b: Self::Mask) -> Self::Mask;
+    /// The mask negated, per lane.
+    fn not(mask: Self::Mask) -> Self::Mask;
+    /// Whether any lane of `mask` is set.
+    fn any(mask: Self::Mask) -> bool;
     /// `if mask { if_true } else { if_false }`, per lane.
     fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
 }
@@ -160,8 +170,33 @@ impl Lane for f32 {
     }
 
     #[inline(always)]
+    fn ge(self, other: f32) -> bool {
+        self >= other
+    }
+
+    #[inline(always)]
     fn is_nan(self) -> bool {
         f32::is_nan(self)
+    }
+
+    #[inline(always)]
+    fn and(a: bool, b: bool) -> bool {
+        a & b
+    }
+
+    #[inline(always)]
+    fn or(a: bool, b: bool) -> bool {
+        a | b
+    }
+
+    #[inline(always)]
+    fn not(mask: bool) -> bool {
+        !mask
+    }
+
+    #[inline(always)]
+    fn any(mask: bool) -> bool {
+        mask
     }
 
     #[inline(always)]

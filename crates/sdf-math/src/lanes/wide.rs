@@ -266,8 +266,45 @@ impl<const N: usize, I: Isa> Lane for Wide<N, I> {
     }
 
     #[inline(always)]
+    fn ge(self, other: Self) -> [bool; N] {
+        self.test(other, <f32 as Lane>::ge)
+    }
+
+    #[inline(always)]
     fn is_nan(self) -> [bool; N] {
         self.test(self, |a, _| a.is_nan())
+    }
+
+    #[inline(always)]
+    fn and(a: [bool; N], b: [bool; N]) -> [bool; N] {
+        let mut out = a;
+        for (m, b) in out.iter_mut().zip(b) {
+            *m &= b;
+        }
+        out
+    }
+
+    #[inline(always)]
+    fn or(a: [bool; N], b: [bool; N]) -> [bool; N] {
+        let mut out = a;
+        for (m, b) in out.iter_mut().zip(b) {
+            *m |= b;
+        }
+        out
+    }
+
+    #[inline(always)]
+    fn not(mask: [bool; N]) -> [bool; N] {
+        let mut out = mask;
+        for m in &mut out {
+            *m = !*m;
+        }
+        out
+    }
+
+    #[inline(always)]
+    fn any(mask: [bool; N]) -> bool {
+        mask.iter().any(|&m| m)
     }
 
     #[inline(always)]
