@@ -13,6 +13,7 @@ mod report;
 mod samplers;
 mod scale;
 mod spectrum;
+mod speed;
 mod tradeoff;
 mod variance;
 
@@ -98,6 +99,21 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Measure lueur's samples per second on the shipped scenes (issue 18's
+    /// configuration), against an older lueur binary and Mitsuba 3 where
+    /// there are; writes docs/SPEED.md.
+    Speed {
+        /// 32x32, 4 spp, one round, no Mitsuba: checks the pipeline.
+        #[arg(long)]
+        quick: bool,
+        /// Interleaved rounds (default 5; 1 with --quick).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+        rounds: Option<u32>,
+        /// Another lueur binary (an older commit's, say), run before the
+        /// new one in every round.
+        #[arg(long, value_name = "PATH")]
+        old: Option<PathBuf>,
+    },
     /// Run a command and print its peak resident set in kB (used by
     /// `memory`, one process per measurement).
     #[command(hide = true)]
@@ -117,6 +133,7 @@ fn main() -> Result<()> {
         Command::Peers { quick } => peers::run(quick),
         Command::Scale { quick } => scale::run(quick),
         Command::Replicates { quick } => replicates::run(quick),
+        Command::Speed { quick, rounds, old } => speed::run(quick, rounds, old.as_deref()),
         Command::MemoryProbe { command } => memory::probe(&command),
     }
 }

@@ -77,8 +77,9 @@ fn peak_rss_mb(program: &Path, args: &[String]) -> Result<(f64, f64)> {
     Ok((kb * 1024.0 / 1e6, secs))
 }
 
-/// Builds the release `lueur` and returns its path.
-fn build_lueur() -> Result<PathBuf> {
+/// Builds the release `lueur` (`cargo build --release -p lueur-cli`) and
+/// returns its path, under `$CARGO_TARGET_DIR` when that is set.
+pub fn build_lueur() -> Result<PathBuf> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(cargo)
         .args(["build", "--release", "-p", "lueur-cli"])

@@ -34,7 +34,8 @@ use crate::reference::{Reference, cache_dir, flatten, render_film};
 use crate::report::{Plans, write_report};
 use crate::{load_scene, project_root};
 
-const SCENE: &str = "cornell-spheres";
+/// The one shipped scene Mitsuba can express as it is.
+pub const SCENE: &str = "cornell-spheres";
 const LLVM19: &str = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1";
 
 struct Plan {
@@ -118,7 +119,9 @@ fn read_rgb(path: &Path) -> Result<Rgb> {
     Ok(Rgb { width, pixels })
 }
 
-fn python() -> Command {
+/// `python3` (or `$LUEUR_PYTHON`), with `DRJIT_LIBLLVM_PATH` pointing at
+/// Debian's libLLVM 19 when it is there and the variable is unset.
+pub fn python() -> Command {
     let mut c = Command::new(std::env::var("LUEUR_PYTHON").unwrap_or_else(|_| "python3".into()));
     if std::env::var_os("DRJIT_LIBLLVM_PATH").is_none() && Path::new(LLVM19).exists() {
         c.env("DRJIT_LIBLLVM_PATH", LLVM19);
@@ -137,9 +140,9 @@ fn scene_path() -> PathBuf {
     project_root().join("scenes").join(format!("{SCENE}.toml"))
 }
 
-/// Runs the Mitsuba script; returns the numbers it prints, one `key
-/// value` line each.
-fn mitsuba(args: &[String]) -> Result<HashMap<String, f64>> {
+/// Runs the Mitsuba script on [`SCENE`]; returns the numbers it prints,
+/// one `key value` line each.
+pub fn mitsuba(args: &[String]) -> Result<HashMap<String, f64>> {
     let out = python()
         .arg(script())
         .arg(scene_path())
@@ -164,12 +167,8 @@ fn mitsuba(args: &[String]) -> Result<HashMap<String, f64>> {
 
 pub fn run(quick: bool) -> Result<()> {
     let plan = PLANS.pick(quick);
-    let check = python()
-        .args(["-c", "import mitsuba"])
-        .output()
-        .context("cannot run python3")?;
     ensure!(
-        check.status.success(),
+        mitsuba_installed()?,
         "Mitsuba 3 is not installed for python3: `pip install mitsuba` (and, for llvm_ad_rgb, \
          Debian's libllvm19). It is a peer for this report only, never a dependency of lueur."
     );
@@ -574,7 +573,17 @@ fn summary(md: &mut String, plan: &Plan, results: &[(Config, Vec<Measured>)]) ->
     Ok(())
 }
 
-fn mitsuba_version() -> String {
+/// Whether `python()` can import Mitsuba 3.
+pub fn mitsuba_installed() -> Result<bool> {
+    let check = python()
+        .args(["-c", "import mitsuba"])
+        .output()
+        .context("cannot run python3")?;
+    Ok(check.status.success())
+}
+
+/// Mitsuba's version as Python reports it ("3" when it cannot say).
+pub fn mitsuba_version() -> String {
     python()
         .args(["-c", "import mitsuba; print(mitsuba.__version__)"])
         .output()
