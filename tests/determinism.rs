@@ -24,6 +24,42 @@ fn every_shipped_scene_is_bit_identical_on_one_and_two_threads() {
     }
 }
 
+/// The image is the same bit for bit whatever instruction set the ray streams run on and
+/// however many paths share a wave: a path's rays take the same steps in any lane of any
+/// vector, next to any other rays (a wave of 1 is the one-path loop).
+#[test]
+fn every_simd_level_and_wave_size_gives_the_same_image() {
+    use lueur::integrator::{Execution, render};
+    use lueur::sdf_math::SimdLevel;
+
+    let levels = SimdLevel::available();
+    assert!(levels.contains(&SimdLevel::Scalar) && levels.len() >= 2);
+    for name in SHIPPED {
+        let file = shipped(name);
+        for strategy in [Strategy::Mis, Strategy::Mixture] {
+            let mut settings = file.settings.clone();
+            (
+                settings.width,
+                settings.height,
+                settings.spp,
+                settings.strategy,
+            ) = (20, 12, 4, strategy);
+            let reference = run_with_threads(&file.scene, &settings, 1);
+            for &simd in &levels {
+                for wave in [1, 7, 16, Execution::WAVE] {
+                    let scene =
+                        crate::common::prepared(&file).with_execution(Execution { simd, wave });
+                    let film = render(&scene, &settings, &|_| {}).unwrap().film;
+                    assert!(
+                        film == reference,
+                        "{name} with {strategy}: {simd:?} in waves of {wave} changes the image"
+                    );
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn the_seed_changes_the_image_and_only_the_seed() {
     let file = shipped("donut-mirrors");

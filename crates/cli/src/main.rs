@@ -145,6 +145,11 @@ struct RenderArgs {
     /// reference that speed-ups are measured against.
     #[arg(long)]
     naive: bool,
+    /// The instruction set the ray streams run on: scalar, portable, sse, avx2,
+    /// avx512 or neon (default: the widest this CPU has). The image does not
+    /// depend on it; for measuring and testing.
+    #[arg(long, value_name = "LEVEL")]
+    simd: Option<String>,
     /// Stop at this wall-clock budget in seconds: passes of 1, 1, 2, 4, ...
     /// spp, the last ones cut to what is left (the first always runs).
     #[arg(long, value_name = "SECONDS")]

@@ -8,7 +8,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use lueur_integrator::{Film, PixelBounds, PreparedScene, RenderOutput};
+use lueur_integrator::SimdLevel;
+use lueur_integrator::{Execution, Film, PixelBounds, PreparedScene, RenderOutput};
 use lueur_scene::parse_scene_with;
 use lueur_scene::{Marching, RenderSettings};
 
@@ -92,7 +93,7 @@ fn prepare(args: &mut RenderArgs) -> Result<(Job, Film)> {
     let job = Job {
         file,
         text,
-        scene: PreparedScene::new(parsed.scene),
+        scene: PreparedScene::new(parsed.scene).with_execution(execution(&args)?),
         settings,
         range,
         out,
@@ -254,6 +255,29 @@ fn reference_for(
 
 /// The sample indices to render: a shard's (`--sample-range`, which needs
 /// a checkpoint to save it in), or all of `0..spp`.
+/// How the render runs: `--simd`, checked against what this CPU has.
+fn execution(args: &RenderArgs) -> Result<Execution> {
+    let mut execution = Execution::default();
+    if let Some(name) = &args.simd {
+        let available: Vec<&str> = SimdLevel::available().iter().map(|l| l.name()).collect();
+        let level = SimdLevel::from_name(name).ok_or_else(|| {
+            let known: Vec<&str> = SimdLevel::ALL.iter().map(|l| l.name()).collect();
+            BadInput(format!(
+                "--simd {name}: not a level; the levels are {}",
+                known.join(", ")
+            ))
+        })?;
+        if !level.is_available() {
+            bail!(BadInput(format!(
+                "--simd {name}: this CPU cannot run it; it can run {}",
+                available.join(", ")
+            )));
+        }
+        execution.simd = level;
+    }
+    Ok(execution)
+}
+
 /// When to stop or cut passes short: --time, --target-error,
 /// --partial-every (which needs an image to write, `has_out`).
 fn render_limits(args: &RenderArgs, has_out: bool) -> Result<progressive::Limits> {

@@ -12,9 +12,16 @@ pub fn print_stats(out: &RenderOutput) {
         s.samples as f64 / secs / 1e6
     );
     println!("dropped (NaN/Inf){:>14}", s.dropped_samples);
-    // Shares of the threads' time: tracing estimated from every 16th ray
-    // (timed), the film merge measured, the rest (camera rays, shading,
-    // sampling, the point set, scheduling) by difference.
+    if let Some(level) = s.simd {
+        println!(
+            "ray streams on   {:>14}  ({} lanes)",
+            level.name(),
+            level.lanes()
+        );
+    }
+    // Shares of the threads' time: tracing measured per stream of rays, the
+    // film merge measured, the rest (camera rays, shading, sampling, the
+    // point set, scheduling) by difference.
     let threads = s.threads.max(1);
     let tracing = s.rays.camera.tracing_seconds()
         + s.rays.bounce.tracing_seconds()

@@ -562,6 +562,83 @@ pub(crate) mod tests {
         })
     }
 
+    /// A ray's outcome and object as bits, so that equality is bitwise.
+    fn bits((outcome, object): (TraceOutcome, Option<usize>)) -> (u8, u32, u32, Option<usize>) {
+        match outcome {
+            TraceOutcome::Hit { t, steps } => (0, t.to_bits(), steps, object),
+            TraceOutcome::Miss { steps } => (1, 0, steps, object),
+            TraceOutcome::GaveUp { t, steps } => (2, t.to_bits(), steps, object),
+        }
+    }
+
+    /// Fast marching's streams: every ray of a stream, in any lane of any vector width
+    /// and next to any rays, ends as it ends when marched alone, and names the same object.
+    #[test]
+    fn a_stream_marches_each_ray_as_it_marches_alone() {
+        // The crowd, and a lattice of small spheres that most rays pass near without
+        // meeting their boxes: the objects nearest a ray are then often not its
+        // candidates, which its lane must not see.
+        let lattice: Vec<Object> = (0..27)
+            .map(|i| Object {
+                sdf: Sdf::torus(0.12, 0.04)
+                    .translate(Vec3::new((i % 3) as f32, (i / 3 % 3) as f32, (i / 9) as f32) * 0.6),
+                material: 0,
+            })
+            .collect();
+        for objects in [crowd(), lattice] {
+            check_streams(&Geometry::new(&objects));
+        }
+    }
+
+    fn check_streams(geometry: &Geometry) {
+        let (mut rays, mut params) = (Vec::new(), Vec::new());
+        for (i, p) in points().take(600).enumerate() {
+            let origin =
+                Vec3::new(0.0, 0.5, 6.0) + Vec3::Y * (i % 3) as f32 - Vec3::Z * (i % 5) as f32;
+            rays.push(Ray::new(origin, p * 0.1 - origin));
+            params.push(TraceParams {
+                t_min: if i % 11 == 0 { 0.5 } else { 0.0 },
+                t_max: if i % 7 == 0 { 4.0 } else { 200.0 },
+                max_steps: if i % 13 == 0 {
+                    1 + (i % 3) as u32
+                } else {
+                    10_000
+                },
+                eps_abs: 1e-6,
+                eps_rel: 1e-5,
+            });
+        }
+        let alone: Vec<_> = rays
+            .iter()
+            .zip(&params)
+            .map(|(r, p)| bits(geometry.trace(r, p, Marching::Fast)))
+            .collect();
+        for kind in 0..3 {
+            assert!(
+                alone.iter().any(|b| b.0 == kind),
+                "no outcome of kind {kind}"
+            );
+        }
+        for level in SimdLevel::available() {
+            for stream in [1, 7, 16, 600] {
+                let mut got = vec![None; rays.len()];
+                let mut batch = MarchBatch::default();
+                for start in (0..rays.len()).step_by(stream) {
+                    batch.clear();
+                    for i in start..(start + stream).min(rays.len()) {
+                        batch.queue(i, rays[i], params[i]);
+                    }
+                    geometry.march(level, &mut batch);
+                    for (i, outcome, object) in batch.results() {
+                        got[i] = Some(bits((outcome, object)));
+                    }
+                }
+                let got: Vec<_> = got.into_iter().map(Option::unwrap).collect();
+                assert!(got == alone, "{level:?}, streams of {stream}");
+            }
+        }
+    }
+
     #[test]
     fn culling_gives_the_plain_union() {
         let geometry = Geometry::new(&crowd());

@@ -62,6 +62,7 @@ mod surface;
 mod trace;
 
 pub use film::{BlockSlots, Film, FilmError, PixelStats, SlotFill, dyadic_blocks, is_dyadic};
+pub use lueur_sdf_math::SimdLevel;
 pub use path::RayCounters;
 pub use render::{
     Pass, PixelBounds, RenderOutput, RenderStats, render, render_pass, render_pass_in,

@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 
 use glam::UVec2;
 use lueur_sampling::Sampler;
+use lueur_sdf_math::SimdLevel;
 use rayon::prelude::*;
 
 use crate::film::{Film, PixelStats};
@@ -38,6 +39,8 @@ pub struct RenderStats {
     pub film_time: Duration,
     /// Threads the render ran on (of the rayon pool in force).
     pub threads: usize,
+    /// The instruction set the ray streams ran on (`None` before any pass).
+    pub simd: Option<SimdLevel>,
 }
 
 impl RenderStats {
@@ -49,6 +52,7 @@ impl RenderStats {
         self.elapsed += other.elapsed;
         self.film_time += other.film_time;
         self.threads = self.threads.max(other.threads);
+        self.simd = self.simd.or(other.simd);
     }
 }
 
@@ -211,7 +215,9 @@ pub fn render_pass_in(
         march: March::new(scene, settings),
         tracing: Tracing {
             marching: settings.marching,
-            simd: scene.execution().simd,
+            simd: Some(scene.execution().simd)
+                .filter(|level| level.is_available())
+                .unwrap_or_else(SimdLevel::detect),
         },
     };
     let tiles_x = w.div_ceil(TILE);
@@ -263,6 +269,7 @@ pub fn render_pass_in(
     let complete = done.iter().all(|&d| d);
     film.end_pass(plan, TILE, done);
     stats.threads = rayon::current_num_threads();
+    stats.simd = Some(estimator.tracing.simd);
     stats.elapsed = start.elapsed();
     Ok(Pass { stats, complete })
 }

@@ -88,6 +88,24 @@ impl SimdLevel {
         }
     }
 
+    /// The level's name on a command line: `scalar`, `portable`, `sse`, `avx2`, `avx512`,
+    /// `neon`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SimdLevel::Scalar => "scalar",
+            SimdLevel::Portable => "portable",
+            SimdLevel::Sse => "sse",
+            SimdLevel::Avx2 => "avx2",
+            SimdLevel::Avx512 => "avx512",
+            SimdLevel::Neon => "neon",
+        }
+    }
+
+    /// The level named `name` ([`SimdLevel::name`]), if any.
+    pub fn from_name(name: &str) -> Option<SimdLevel> {
+        Self::ALL.into_iter().find(|level| level.name() == name)
+    }
+
     /// How many lanes the level's lane type holds.
     pub fn lanes(self) -> usize {
         match self {
