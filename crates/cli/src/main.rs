@@ -150,6 +150,10 @@ struct RenderArgs {
     /// depend on it; for measuring and testing.
     #[arg(long, value_name = "LEVEL")]
     simd: Option<String>,
+    /// Paths advanced together, whose rays are traced as one stream (default
+    /// 256). The image does not depend on it; for measuring and testing.
+    #[arg(long, value_name = "PATHS")]
+    wave: Option<usize>,
     /// Stop at this wall-clock budget in seconds: passes of 1, 1, 2, 4, ...
     /// spp, the last ones cut to what is left (the first always runs).
     #[arg(long, value_name = "SECONDS")]

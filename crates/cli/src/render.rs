@@ -255,9 +255,14 @@ fn reference_for(
 
 /// The sample indices to render: a shard's (`--sample-range`, which needs
 /// a checkpoint to save it in), or all of `0..spp`.
-/// How the render runs: `--simd`, checked against what this CPU has.
+/// How the render runs: `--simd`, checked against what this CPU has, and `--wave`.
 fn execution(args: &RenderArgs) -> Result<Execution> {
     let mut execution = Execution::default();
+    match args.wave {
+        Some(0) => bail!(BadInput("--wave must be at least 1".into())),
+        Some(wave) => execution.wave = wave,
+        None => {}
+    }
     if let Some(name) = &args.simd {
         let available: Vec<&str> = SimdLevel::available().iter().map(|l| l.name()).collect();
         let level = SimdLevel::from_name(name).ok_or_else(|| {
