@@ -93,7 +93,7 @@ fn prepare(args: &mut RenderArgs) -> Result<(Job, Film)> {
     let job = Job {
         file,
         text,
-        scene: PreparedScene::new(parsed.scene).with_execution(execution(&args)?),
+        scene: PreparedScene::new(parsed.scene).with_execution(execution(args)?),
         settings,
         range,
         out,

@@ -91,6 +91,9 @@ pub(crate) struct MarchBatch {
     nearest: Vec<u32>,
     /// Per lane and position in the order, while clipping: the lane's candidates.
     clipped: Vec<u32>,
+    /// While marching, [`CandidateLanes`]'s `member` and `members`.
+    member: Vec<[f32; MAX_LANES]>,
+    members: Vec<u32>,
 }
 
 impl MarchBatch {
@@ -234,8 +237,8 @@ struct CandidateLanes<'a> {
     lane_ray: [Option<usize>; MAX_LANES],
     /// Per position in the order: which lanes' rays have that object as a candidate (1 or
     /// 0, loaded as a vector), and how many.
-    member: Vec<[f32; MAX_LANES]>,
-    members: Vec<u32>,
+    member: &'a mut [[f32; MAX_LANES]],
+    members: &'a mut [u32],
     /// Per lane: its ray's first candidate, the nearest object before any is evaluated,
     /// and the nearest object at its last evaluation (object indices, exact in f32).
     first: [f32; MAX_LANES],
@@ -252,14 +255,18 @@ impl<'a> CandidateLanes<'a> {
         batch.outcomes.resize(n, TraceOutcome::Miss { steps: 0 });
         batch.nearest.clear();
         batch.nearest.resize(n, 0);
+        batch.member.clear();
+        batch.member.resize(geometry.order.len(), [0.0; MAX_LANES]);
+        batch.members.clear();
+        batch.members.resize(geometry.order.len(), 0);
         let lanes = CandidateLanes {
             geometry,
             spans: &batch.spans,
             candidates: &batch.candidates,
             nearest: &mut batch.nearest,
             lane_ray: [None; MAX_LANES],
-            member: vec![[0.0; MAX_LANES]; geometry.order.len()],
-            members: vec![0; geometry.order.len()],
+            member: &mut batch.member,
+            members: &mut batch.members,
             first: [0.0; MAX_LANES],
             last: [0.0; MAX_LANES],
         };

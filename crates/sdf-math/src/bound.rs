@@ -292,7 +292,8 @@ impl<L: Lane> RayClipLanes<L> {
         let rel = LaneVec3::new(eps_rel, eps_rel, eps_rel);
         #[inline(always)]
         fn finite<L: Lane>(v: L) -> L::Mask {
-            L::not(L::or(v.is_nan(), (v - v).is_nan()))
+            // Zero times infinity is NaN, as is zero times NaN.
+            (v * L::splat(0.0)).ge(L::splat(0.0))
         }
         #[inline(always)]
         fn all_finite<L: Lane>(v: LaneVec3<L>) -> L::Mask {
