@@ -7,7 +7,7 @@ use glam::Vec3;
 use lueur_sdf_math::{
     Aabb, DistanceField, HalfSpace, Lane, LaneDistance, LaneKernel, LaneVec3, MAX_LANES,
     OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClipLanes, Sdf, SimdLevel, StreamField,
-    TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed_stream_of,
+    TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed_stream_of, write_lane,
 };
 
 use lueur_scene::{Marching, Object};
@@ -169,9 +169,7 @@ impl LaneKernel for Clip<'_> {
                     p.t_min,
                     p.t_max,
                 ];
-                for (row, value) in v.iter_mut().zip(values) {
-                    row[lane] = value;
-                }
+                write_lane(&mut v, lane, values);
             }
             let row = |i: usize| -> &[f32] { &v[i][..lanes] };
             let (t_min, t_max) = (L::load(row(8)), L::load(row(9)));

@@ -124,11 +124,71 @@ pub(crate) struct WaveScratch {
     rays: Vec<PathRay>,
     hits: Vec<Option<Hit>>,
     shaded: Vec<Shaded>,
-    shadow_rays: Vec<ShadowRay>,
-    contributions: Vec<Vec3>,
+    shadow: ShadowQueue,
     free: Vec<bool>,
     trace: TraceScratch,
+}
+
+/// The shadow rays a wave's vertices propose, with what each would bring.
+#[derive(Default)]
+struct ShadowQueue {
+    rays: Vec<ShadowRay>,
+    contributions: Vec<Vec3>,
+    /// One vertex's delta lights, before they join the queue.
     lights: Vec<(ShadowRay, Vec3)>,
+}
+
+/// Shades path `index` where it met `on_surface`: the shading point, the shadow rays the vertex
+/// proposes (queued in `shadow`; at a diffuse vertex the delta lights', then next-event
+/// estimation's where the strategy uses it) and the direction it scatters in.
+fn shade(
+    estimator: &Estimator<'_>,
+    lighting: &Lighting<'_>,
+    (index, path): (usize, &Path),
+    on_surface: SurfaceHit,
+    u: &VertexSample,
+    shadow: &mut ShadowQueue,
+) -> Shaded {
+    let Estimator {
+        scene,
+        settings,
+        march,
+        ..
+    } = *estimator;
+    let surface = SurfacePoint::at_hit(scene, &march, &path.ray, on_surface);
+    let material = scene.scene().materials[scene.scene().objects[on_surface.object].material];
+    let vertex = Vertex {
+        at: surface,
+        wo: -path.ray.dir,
+        material,
+    };
+    let first = shadow.rays.len();
+    let (diffuse, next_event, scatter) = match material {
+        Material::Mirror { .. } => (false, false, strategy::mirror(&vertex, u.bsdf)),
+        Material::Lambertian { .. } => {
+            shadow.lights.clear();
+            lighting.delta_lights(&vertex, &mut shadow.lights);
+            let nee = strategy::uses_next_event(settings.strategy)
+                .then(|| lighting.next_event(&vertex, u))
+                .flatten();
+            let next_event = nee.is_some();
+            for (ray, contribution) in shadow.lights.drain(..).chain(nee) {
+                shadow.rays.push(ray);
+                shadow.contributions.push(contribution);
+            }
+            let scatter = strategy::scatter(settings.strategy, &lighting.emitters, &vertex, u);
+            (true, next_event, scatter)
+        }
+    };
+    Shaded {
+        path: index,
+        surface,
+        diffuse,
+        shadow: (first, shadow.rays.len()),
+        next_event,
+        scatter,
+        roulette: u.roulette,
+    }
 }
 
 /// Radiance arriving along each of `camera_rays` (sample `ids[i]` for ray `i`), estimated
@@ -185,8 +245,8 @@ pub(crate) fn radiance_wave(
         scene.intersect_rays(&s.rays, tracing, kind, &mut s.trace, &mut s.hits);
 
         s.shaded.clear();
-        s.shadow_rays.clear();
-        s.contributions.clear();
+        s.shadow.rays.clear();
+        s.shadow.contributions.clear();
         for (&i, &hit) in s.active.iter().zip(&s.hits) {
             let path = &mut s.paths[i];
             let Some(on_surface) = SurfaceHit::of(hit) else {
@@ -197,47 +257,18 @@ pub(crate) fn radiance_wave(
             if path.depth >= settings.max_depth {
                 continue;
             }
-            let surface = SurfacePoint::at_hit(scene, &march, &path.ray, on_surface);
-            let material =
-                scene.scene().materials[scene.scene().objects[on_surface.object].material];
-            let vertex = Vertex {
-                at: surface,
-                wo: -path.ray.dir,
-                material,
-            };
-            let id = ids[i];
-            let u = VertexSample::draw(sampler, id.pixel, id.index, path.depth);
-            let first = s.shadow_rays.len();
-            let (diffuse, next_event, scatter) = match material {
-                Material::Mirror { .. } => (false, false, strategy::mirror(&vertex, u.bsdf)),
-                Material::Lambertian { .. } => {
-                    s.lights.clear();
-                    lighting.delta_lights(&vertex, &mut s.lights);
-                    let nee = strategy::uses_next_event(settings.strategy)
-                        .then(|| lighting.next_event(&vertex, &u))
-                        .flatten();
-                    let next_event = nee.is_some();
-                    for (ray, contribution) in s.lights.drain(..).chain(nee) {
-                        s.shadow_rays.push(ray);
-                        s.contributions.push(contribution);
-                    }
-                    let scatter =
-                        strategy::scatter(settings.strategy, &lighting.emitters, &vertex, &u);
-                    (true, next_event, scatter)
-                }
-            };
-            s.shaded.push(Shaded {
-                path: i,
-                surface,
-                diffuse,
-                shadow: (first, s.shadow_rays.len()),
-                next_event,
-                scatter,
-                roulette: u.roulette,
-            });
+            let u = VertexSample::draw(sampler, ids[i].pixel, ids[i].index, path.depth);
+            s.shaded.push(shade(
+                estimator,
+                &lighting,
+                (i, path),
+                on_surface,
+                &u,
+                &mut s.shadow,
+            ));
         }
         scene.unoccluded_rays(
-            &s.shadow_rays,
+            &s.shadow.rays,
             &lighting.params,
             tracing,
             &mut counters.shadow,
@@ -249,7 +280,7 @@ pub(crate) fn radiance_wave(
         for shaded in &s.shaded {
             let path = &mut s.paths[shaded.path];
             if shaded.diffuse {
-                gather(path, shaded, &s.contributions, &s.free, settings);
+                gather(path, shaded, &s.shadow.contributions, &s.free, settings);
             }
             if scatter(path, shaded, &march, settings) {
                 s.active.push(shaded.path);

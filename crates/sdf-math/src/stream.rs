@@ -40,6 +40,15 @@ pub trait StreamField {
     fn distance_lanes<L: Lane>(&mut self, p: LaneVec3<L>) -> L;
 }
 
+/// Sets lane `lane` of each row to its value: how a kernel that keeps its lanes' state as
+/// rows of `f32` (structure of arrays) puts a new ray in a lane.
+#[inline(always)]
+pub fn write_lane<const R: usize>(rows: &mut [[f32; MAX_LANES]; R], lane: usize, values: [f32; R]) {
+    for (row, value) in rows.iter_mut().zip(values) {
+        row[lane] = value;
+    }
+}
+
 /// One field for every ray of a stream.
 struct Shared<'a, F: ?Sized>(&'a F);
 
@@ -323,9 +332,7 @@ impl<F: StreamField> RelaxedStream<'_, F> {
                         s.eps_abs,
                         s.eps_rel,
                     ];
-                    for (row, value) in rows.iter_mut().zip(values) {
-                        row[lane] = value;
-                    }
+                    write_lane(rows, lane, values);
                     self.field.assign(lane, Some(ray));
                     return Some(ray);
                 }
