@@ -15,11 +15,12 @@
 //! from a vertex and its random numbers to a named scatter (`strategy.rs`),
 //! so the five ways of choosing a direction share everything else (tracing,
 //! mirrors, Russian roulette, directional lights) and differ only where the
-//! report says they do; the path loop (`path.rs`) strings the stages
-//! together.
+//! report says they do; the wave of paths (`path.rs`) strings the stages
+//! together, tracing each kind of ray as one SIMD stream.
 //!
 //! Contracts: renders are deterministic (same scene, settings and seed give
-//! the same film bit for bit, whatever the thread count); NaN or infinite
+//! the same film bit for bit, whatever the thread count, the SIMD level or
+//! the number of paths per wave, [`Execution`]); NaN or infinite
 //! samples never reach the film (they are counted in
 //! [`RenderStats::dropped_samples`]); every strategy but `light` is unbiased.
 //!
