@@ -421,27 +421,12 @@ impl Geometry {
         Inside(self)
     }
 
-    /// Marches `ray` through the objects as `marching` says; with a hit, the object hit.
-    pub fn trace(
-        &self,
-        ray: &Ray,
-        params: &TraceParams,
-        marching: Marching,
-    ) -> (TraceOutcome, Option<usize>) {
-        match marching {
-            Marching::Naive => {
-                let outcome = sphere_trace(&Naive(self), ray, params);
-                let object = outcome.hit_t().map(|t| self.closest_object(ray.at(t)));
-                (outcome, object)
-            }
-            Marching::Fast => {
-                let mut batch = MarchBatch::default();
-                batch.queue(0, *ray, *params);
-                self.march(SimdLevel::Scalar, &mut batch);
-                let (_, outcome, object) = batch.results().next().expect("one ray was marched");
-                (outcome, object)
-            }
-        }
+    /// Marches `ray` through the plain union ([`Marching::Naive`]); with a hit, the
+    /// object hit. Fast marching marches streams ([`Geometry::march`]).
+    pub fn trace_naive(&self, ray: &Ray, params: &TraceParams) -> (TraceOutcome, Option<usize>) {
+        let outcome = sphere_trace(&Naive(self), ray, params);
+        let object = outcome.hit_t().map(|t| self.closest_object(ray.at(t)));
+        (outcome, object)
     }
 
     /// Clips every ray queued in `batch` against the objects' bounds and marches those
@@ -616,7 +601,13 @@ pub(crate) mod tests {
         let alone: Vec<_> = rays
             .iter()
             .zip(&params)
-            .map(|(r, p)| bits(geometry.trace(r, p, Marching::Fast)))
+            .map(|(r, p)| {
+                let mut batch = MarchBatch::default();
+                batch.queue(0, *r, *p);
+                geometry.march(SimdLevel::Scalar, &mut batch);
+                let (_, outcome, object) = batch.results().next().unwrap();
+                bits((outcome, object))
+            })
             .collect();
         for kind in 0..3 {
             assert!(

@@ -57,12 +57,10 @@ pub struct TraceCounters {
     /// `2^i ..= 2^(i+1) - 1` steps (bucket 0 also counts rays of 0 steps,
     /// the last one every ray of 512 steps or more).
     pub steps_histogram: [u64; STEP_BUCKETS],
-    /// Rays traced by the timed streams (every stream is timed as a whole: the clock,
-    /// tens of nanoseconds a reading, is read twice per stream of many rays).
-    pub timed_rays: u64,
-    /// Wall time spent tracing the timed rays (bounds, marching, lights), in
-    /// nanoseconds. Never affects the image.
-    pub timed_nanos: u64,
+    /// Wall time spent tracing these rays (bounds, marching, lights), in nanoseconds:
+    /// every stream is timed as a whole (the clock, tens of nanoseconds a reading, is read
+    /// twice per stream of many rays). Never affects the image.
+    pub tracing_nanos: u64,
 }
 
 /// Buckets of [`TraceCounters::steps_histogram`].
@@ -82,27 +80,20 @@ impl TraceCounters {
         }
     }
 
-    /// Estimated wall time spent tracing every ray: the timed rays' time
-    /// scaled by the share they are of all rays.
+    /// Wall time spent tracing the rays.
     pub fn tracing_seconds(&self) -> f64 {
-        if self.timed_rays == 0 {
-            return 0.0;
-        }
-        self.timed_nanos as f64 * 1e-9 * self.rays as f64 / self.timed_rays as f64
+        self.tracing_nanos as f64 * 1e-9
     }
 
-    /// Adds the time of a stream that started at `start` and traced the rays counted
-    /// since `rays_before`.
-    fn timed(&mut self, start: Instant, rays_before: u64) {
-        self.timed_rays += self.rays - rays_before;
-        self.timed_nanos += start.elapsed().as_nanos() as u64;
+    /// Adds the time of a stream that started at `start`.
+    fn timed(&mut self, start: Instant) {
+        self.tracing_nanos += start.elapsed().as_nanos() as u64;
     }
 
     /// Adds another set of counters.
     pub fn merge(&mut self, o: &TraceCounters) {
         self.rays += o.rays;
-        self.timed_rays += o.timed_rays;
-        self.timed_nanos += o.timed_nanos;
+        self.tracing_nanos += o.tracing_nanos;
         self.steps += o.steps;
         self.hits += o.hits;
         self.misses += o.misses;
@@ -222,7 +213,7 @@ impl PreparedScene {
         scratch: &mut TraceScratch,
         hits: &mut Vec<Option<Hit>>,
     ) {
-        let (clock, rays_before) = (Instant::now(), counters.rays);
+        let clock = Instant::now();
         hits.clear();
         scratch.batch.clear();
         scratch.marched.clear();
@@ -251,7 +242,7 @@ impl PreparedScene {
             let done = if inside {
                 Some((sphere_trace(&self.geometry.inside(), &r.ray, &p), None))
             } else if tracing.marching == Marching::Naive {
-                Some(self.geometry.trace(&r.ray, &p, Marching::Naive))
+                Some(self.geometry.trace_naive(&r.ray, &p))
             } else {
                 scratch.batch.queue(i, r.ray, p);
                 None
@@ -272,7 +263,7 @@ impl PreparedScene {
                 .surface_hit(&rays[i].ray, &p, inside, outcome, object)
                 .or(hits[i]);
         }
-        counters.timed(clock, rays_before);
+        counters.timed(clock);
     }
 
     /// The surface a march of `ray` with parameters `params` found, if any.
@@ -323,7 +314,7 @@ impl PreparedScene {
         scratch: &mut TraceScratch,
         free: &mut Vec<bool>,
     ) {
-        let (clock, rays_before) = (Instant::now(), counters.rays);
+        let clock = Instant::now();
         free.clear();
         scratch.batch.clear();
         for (i, r) in rays.iter().enumerate() {
@@ -341,7 +332,7 @@ impl PreparedScene {
             let p = TraceParams { t_max, ..*params };
             match tracing.marching {
                 Marching::Naive => {
-                    let outcome = self.geometry.trace(&r.ray, &p, Marching::Naive).0;
+                    let outcome = self.geometry.trace_naive(&r.ray, &p).0;
                     counters.record(&outcome);
                     free[i] = matches!(outcome, TraceOutcome::Miss { .. });
                 }
@@ -354,7 +345,7 @@ impl PreparedScene {
             // A shadow ray that gives up is taken as a hit too (see `surface_hit`).
             free[i] = matches!(outcome, TraceOutcome::Miss { .. });
         }
-        counters.timed(clock, rays_before);
+        counters.timed(clock);
     }
 
     fn intersect_lights(&self, ray: &Ray, t_max: f32, skip: Option<usize>) -> Option<(f32, usize)> {

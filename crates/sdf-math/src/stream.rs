@@ -1,17 +1,18 @@
 //! Sphere tracing a stream of rays, one lane of a SIMD vector each, plain or over-relaxed.
 //!
 //! The field is the expensive part of a march and the same formula for every ray, so it is
-//! evaluated for a vector of rays at once ([`LaneDistance::distance_lanes`]); the control
-//! of each march (hit, miss, give-up, the next `t`) stays per lane, in the state machine
-//! [`sphere_trace`] itself runs (`HartMarch`; `RelaxedMarch` for
-//! [`sphere_trace_relaxed`]). A lane whose ray is done takes the next ray
-//! of the stream at once, so the vector stays full until the stream runs dry, whatever the
-//! mix of short and long marches.
+//! evaluated for a vector of rays at once ([`LaneDistance::distance_lanes`], or a
+//! [`StreamField`] that differs per ray). The plain march keeps each lane's control (hit,
+//! miss, give-up, the next `t`) per lane, in the state machine [`sphere_trace`] itself
+//! runs (`HartMarch`); the over-relaxed one advances every lane's control in one vector
+//! step (`RelaxedLanes`, whose one-lane instance [`sphere_trace_relaxed`] runs). A lane
+//! whose ray is done takes the next ray of the stream at once, so the vector stays full
+//! until the stream runs dry, whatever the mix of short and long marches.
 //!
 //! Contract: every ray's outcome is, bit for bit, what [`sphere_trace`] (or
-//! [`sphere_trace_relaxed`]) gives for it, on
-//! every [`SimdLevel`] and for any length of stream: each lane's field value equals the
-//! scalar one (the lane contract), and the march around it is the same code.
+//! [`sphere_trace_relaxed`]) gives for it, on every [`SimdLevel`] and for any length of
+//! stream: each lane's field value equals the scalar one (the lane contract), and the
+//! march around it is the same code.
 
 use crate::lanes::{Lane, LaneDistance, LaneKernel, LaneVec3, SimdLevel, UnavailableLevel};
 use crate::relaxed::{RelaxedLanes, point_at, status};
@@ -171,48 +172,44 @@ pub fn sphere_trace_relaxed_stream_of<F: StreamField>(
         })
     } else {
         // As `sphere_trace_relaxed` does: no factor above 1 is the plain march.
-        level.dispatch(Stream {
+        level.dispatch(PlainStream {
             field,
             rays,
             params,
             out,
-            start: |ray: &Ray, params: &TraceParams| HartMarch::start(lipschitz, ray, params),
+            lipschitz,
         })
     }
 }
 
-/// The kernel behind every stream: `start` begins a ray's march.
-struct Stream<'a, F, S> {
+/// The kernel of the plain streams: the field per vector, each lane's march
+/// ([`HartMarch`]) per lane.
+struct PlainStream<'a, F> {
     field: &'a mut F,
     rays: &'a [Ray],
     params: &'a [TraceParams],
     out: &'a mut [TraceOutcome],
-    start: S,
+    lipschitz: f32,
 }
 
 /// A lane's march, the index of its ray in the stream, and the point its march evaluates
 /// next.
 #[derive(Clone, Copy)]
-struct InFlight<M> {
-    march: M,
+struct InFlight {
+    march: HartMarch,
     ray: usize,
     point: Vec3,
 }
 
-impl<F, S, M> Stream<'_, F, S>
-where
-    F: StreamField,
-    S: Fn(&Ray, &TraceParams) -> Result<M, TraceOutcome>,
-    M: March,
-{
+impl<F: StreamField> PlainStream<'_, F> {
     /// The next ray of the stream that needs the field at all, from `*next` on, for
     /// `lane`; rays that end before their first evaluation get their outcome here.
     #[inline(always)]
-    fn take(&mut self, lane: usize, next: &mut usize) -> Option<InFlight<M>> {
+    fn take(&mut self, lane: usize, next: &mut usize) -> Option<InFlight> {
         while *next < self.rays.len() {
             let ray = *next;
             *next += 1;
-            let started = (self.start)(&self.rays[ray], &self.params[ray]);
+            let started = HartMarch::start(self.lipschitz, &self.rays[ray], &self.params[ray]);
             match started.and_then(|march| Ok((march, march.next_point()?))) {
                 Ok((march, point)) => {
                     self.field.assign(lane, Some(ray));
@@ -226,18 +223,13 @@ where
     }
 }
 
-impl<F, S, M> LaneKernel for Stream<'_, F, S>
-where
-    F: StreamField,
-    S: Fn(&Ray, &TraceParams) -> Result<M, TraceOutcome>,
-    M: March,
-{
+impl<F: StreamField> LaneKernel for PlainStream<'_, F> {
     type Output = ();
 
     #[inline(always)]
     fn run<L: Lane>(mut self) {
         let lanes = L::LANES.min(MAX_LANES);
-        let mut flight: [Option<InFlight<M>>; MAX_LANES] = [None; MAX_LANES];
+        let mut flight: [Option<InFlight>; MAX_LANES] = [None; MAX_LANES];
         let mut next = 0;
         for (lane, slot) in flight.iter_mut().enumerate().take(lanes) {
             *slot = self.take(lane, &mut next);
