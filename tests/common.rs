@@ -19,6 +19,16 @@ pub fn prepared(file: &SceneFile) -> PreparedScene {
     PreparedScene::new(file.scene.clone())
 }
 
+/// `settings` at `width` x `height` and `spp`, for a test render small enough to repeat.
+pub fn sized(settings: &RenderSettings, [width, height]: [u32; 2], spp: u32) -> RenderSettings {
+    RenderSettings {
+        width,
+        height,
+        spp,
+        ..settings.clone()
+    }
+}
+
 pub const SHIPPED: [&str; 3] = ["cornell-spheres", "death-star", "donut-mirrors"];
 
 /// Renders on the current rayon pool with no progress reporting.

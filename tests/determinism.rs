@@ -1,19 +1,14 @@
 use lueur::scene::Strategy;
 
-use crate::common::{SHIPPED, run_with_threads, shipped};
+use crate::common::{SHIPPED, run_with_threads, shipped, sized};
 
 #[test]
 fn every_shipped_scene_is_bit_identical_on_one_and_two_threads() {
     for name in SHIPPED {
         let file = shipped(name);
         for strategy in Strategy::ALL {
-            let mut settings = file.settings.clone();
-            (
-                settings.width,
-                settings.height,
-                settings.spp,
-                settings.strategy,
-            ) = (24, 20, 4, strategy);
+            let mut settings = sized(&file.settings, [24, 20], 4);
+            settings.strategy = strategy;
             let one = run_with_threads(&file.scene, &settings, 1);
             let two = run_with_threads(&file.scene, &settings, 2);
             assert!(
@@ -37,13 +32,8 @@ fn every_simd_level_and_wave_size_gives_the_same_image() {
     for name in SHIPPED {
         let file = shipped(name);
         for strategy in [Strategy::Mis, Strategy::Mixture] {
-            let mut settings = file.settings.clone();
-            (
-                settings.width,
-                settings.height,
-                settings.spp,
-                settings.strategy,
-            ) = (20, 12, 4, strategy);
+            let mut settings = sized(&file.settings, [20, 12], 4);
+            settings.strategy = strategy;
             let reference = run_with_threads(&file.scene, &settings, 1);
             for &simd in &levels {
                 for wave in [1, 7, 16, Execution::WAVE] {
@@ -63,8 +53,7 @@ fn every_simd_level_and_wave_size_gives_the_same_image() {
 #[test]
 fn the_seed_changes_the_image_and_only_the_seed() {
     let file = shipped("donut-mirrors");
-    let mut settings = file.settings.clone();
-    (settings.width, settings.height, settings.spp) = (16, 16, 2);
+    let mut settings = sized(&file.settings, [16, 16], 2);
     let a = run_with_threads(&file.scene, &settings, 2);
     let again = run_with_threads(&file.scene, &settings, 2);
     settings.seed += 1;
@@ -85,13 +74,8 @@ fn passes_add_up_to_the_single_pass_image_bit_for_bit() {
 
     let file = shipped("donut-mirrors");
     for &sampler in SamplerKind::ALL {
-        let mut settings = file.settings.clone();
-        (
-            settings.width,
-            settings.height,
-            settings.spp,
-            settings.sampler,
-        ) = (20, 18, 8, sampler);
+        let mut settings = sized(&file.settings, [20, 18], 8);
+        settings.sampler = sampler;
         let whole = run_with_threads(&file.scene, &settings, 2);
         let mut film = Film::new(settings.width, settings.height);
         let never = AtomicBool::new(false);
@@ -126,13 +110,8 @@ fn shards_merge_into_the_single_render_bit_for_bit() {
     let file = shipped("donut-mirrors");
     let never = AtomicBool::new(false);
     for &sampler in SamplerKind::ALL {
-        let mut settings = file.settings.clone();
-        (
-            settings.width,
-            settings.height,
-            settings.spp,
-            settings.sampler,
-        ) = (11, 7, 13, sampler);
+        let mut settings = sized(&file.settings, [11, 7], 13);
+        settings.sampler = sampler;
         // Three replicates, which 13 spp does not divide: the interleaved
         // replicates are cut by the shards' ends too.
         settings.replicates = sampler.is_randomized().then_some(3);
@@ -174,8 +153,7 @@ fn a_pass_cancelled_at_once_changes_nothing() {
     use lueur::integrator::{Film, render_pass};
 
     let file = shipped("cornell-spheres");
-    let mut settings = file.settings.clone();
-    (settings.width, settings.height, settings.spp) = (16, 16, 4);
+    let settings = sized(&file.settings, [16, 16], 4);
     let mut film = Film::new(16, 16);
     let first = render_pass(
         &crate::common::prepared(&file),
@@ -235,9 +213,8 @@ fn a_pass_cancelled_midway_keeps_its_finished_tiles() {
     use lueur::integrator::{Film, render_pass};
 
     let file = shipped("cornell-spheres");
-    let mut settings = file.settings.clone();
     // 4 x 3 tiles of 16 pixels, the last column and row of them cut short.
-    (settings.width, settings.height, settings.spp) = (60, 40, 8);
+    let settings = sized(&file.settings, [60, 40], 8);
     let never = AtomicBool::new(false);
     let mut film = Film::new(60, 40);
     for until in [1, 3] {
@@ -339,8 +316,7 @@ fn a_sealed_film_has_the_unsealed_image_bit_for_bit() {
     use lueur::integrator::{Film, FilmError, render_pass};
 
     let file = shipped("donut-mirrors");
-    let mut settings = file.settings.clone();
-    (settings.width, settings.height, settings.spp) = (20, 18, 24);
+    let settings = sized(&file.settings, [20, 18], 24);
     let never = AtomicBool::new(false);
     let run = |film: &mut Film, passes: &[u32]| {
         for &until in passes {
