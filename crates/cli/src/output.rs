@@ -57,8 +57,17 @@ static WRITING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Runs `write` on a temporary file beside `path`, then renames it into
 /// place: readers see the old file or the whole new one, never a torn one.
 pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    write_atomically_in(&WRITING, path, write)
+}
+
+/// [`write_atomically`], the temporary file listed in `writing`.
+fn write_atomically_in(
+    writing: &Mutex<Vec<PathBuf>>,
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<()>,
+) -> Result<()> {
     let tmp = temporary_path(path);
-    let writing = || WRITING.lock().unwrap_or_else(|e| e.into_inner());
+    let writing = || writing.lock().unwrap_or_else(|e| e.into_inner());
     writing().push(tmp.clone());
     let result = write(&tmp).and_then(|()| {
         std::fs::rename(&tmp, path)
@@ -75,7 +84,11 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
 /// the middle of a write, and must not leave one behind. (A rename that
 /// races with this finds no file, and the target is left as it was.)
 pub fn remove_temporaries() {
-    let writing = WRITING.lock().unwrap_or_else(|e| e.into_inner());
+    remove_temporaries_in(&WRITING);
+}
+
+fn remove_temporaries_in(writing: &Mutex<Vec<PathBuf>>) {
+    let writing = writing.lock().unwrap_or_else(|e| e.into_inner());
     for tmp in writing.iter() {
         let _ = std::fs::remove_file(tmp);
     }
@@ -138,21 +151,23 @@ mod tests {
     use super::*;
 
     /// What a second interrupt does in the middle of a write: the
-    /// temporary file goes, and the target is not created from it.
+    /// temporary file goes, and the target is not created from it. On a list
+    /// of its own, so as not to remove the files other tests are writing.
     #[test]
     fn an_exit_mid_write_leaves_no_temporary_file() {
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join("i.png");
-        let result = write_atomically(&target, |tmp| {
+        let writing = Mutex::new(Vec::new());
+        let result = write_atomically_in(&writing, &target, |tmp| {
             std::fs::write(tmp, b"half an image")?;
-            remove_temporaries();
+            remove_temporaries_in(&writing);
             Ok(())
         });
         assert!(result.is_err(), "the rename finds no file");
         let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
         assert!(left.is_empty(), "{left:?}");
         // And a write that is not interrupted is not affected by the list.
-        write_atomically(&target, |tmp| Ok(std::fs::write(tmp, b"whole")?)).unwrap();
+        write_atomically_in(&writing, &target, |tmp| Ok(std::fs::write(tmp, b"whole")?)).unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"whole");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }

@@ -161,18 +161,12 @@ fn write_csv(path: &Path, points: &PointSet) -> Result<()> {
     Ok(())
 }
 
-/// Writes through a temporary file renamed into place, so a failed write
-/// never leaves a partial file under the asked name.
+/// Writes `path` as [`crate::output::write_atomically`] does (a failed write never leaves
+/// a partial file under the asked name, nor a temporary one on an interrupt), naming the
+/// file in the error.
 fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let name = path
-        .file_name()
-        .map_or_else(|| "points".into(), |n| n.to_string_lossy().into_owned());
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    if let Err(e) = write(&tmp) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e).with_context(|| format!("cannot write {}", path.display()));
-    }
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot move {} into place", tmp.display()))
+    crate::output::write_atomically(path, write)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 fn print_metrics(args: &PointsArgs, points: &PointSet) -> Result<()> {
