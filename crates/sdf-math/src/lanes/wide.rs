@@ -19,6 +19,11 @@ use super::{Lane, SimdLevel, Task};
 pub trait Isa: Copy + fmt::Debug + 'static {
     /// The dispatch level it is.
     const LEVEL: SimdLevel;
+    /// How a vector of `N` lanes under this instruction set holds one boolean per lane:
+    /// the form its compares produce and its blends read, so that a mask never has to be
+    /// converted between the two (AVX2 converting `bool`s at every select cost a fifth of
+    /// a render).
+    type Mask<const N: usize>: LaneMask<N>;
     /// Runs `task` in a function compiled with this instruction set's target features, or
     /// as plain code where the CPU lacks them (the results are the same either way).
     fn within<T: Task>(task: T) -> T::Output;
@@ -47,6 +52,7 @@ pub struct Neon;
 
 impl Isa for Portable {
     const LEVEL: SimdLevel = SimdLevel::Portable;
+    type Mask<const N: usize> = BitMask<N>;
     #[inline(always)]
     fn within<T: Task>(task: T) -> T::Output {
         task.run()
@@ -71,9 +77,10 @@ impl<T: Task> pulp::NullaryFnOnce for Pulp<T> {
 
 /// One `Isa` per pulp token: `within` enters the token's target-feature context.
 macro_rules! pulp_isa {
-    ($isa:ident, $level:ident, $arch:meta, $token:path) => {
+    ($isa:ident, $level:ident, $mask:ident, $arch:meta, $token:path) => {
         impl Isa for $isa {
             const LEVEL: SimdLevel = SimdLevel::$level;
+            type Mask<const N: usize> = $mask<N>;
             #[inline(always)]
             fn within<T: Task>(task: T) -> T::Output {
                 #[cfg($arch)]
@@ -91,22 +98,31 @@ macro_rules! pulp_isa {
 pulp_isa!(
     Sse,
     Sse,
+    BitMask,
     any(target_arch = "x86", target_arch = "x86_64"),
     pulp::x86::V2
 );
 pulp_isa!(
     Avx2,
     Avx2,
+    BitMask,
     any(target_arch = "x86", target_arch = "x86_64"),
     pulp::x86::V3
 );
 pulp_isa!(
     Avx512,
     Avx512,
+    BoolMask,
     any(target_arch = "x86", target_arch = "x86_64"),
     pulp::x86::V4
 );
-pulp_isa!(Neon, Neon, target_arch = "aarch64", pulp::aarch64::Neon);
+pulp_isa!(
+    Neon,
+    Neon,
+    BitMask,
+    target_arch = "aarch64",
+    pulp::aarch64::Neon
+);
 
 /// `N` lanes of `f32` compiled for the instruction set `I`.
 #[derive(Clone, Copy)]
@@ -148,12 +164,137 @@ impl<const N: usize, I> Wide<N, I> {
         }
         Self::from_array(out)
     }
+}
+
+/// One boolean per lane of an `N`-lane vector, in the form an instruction set's compares
+/// and blends use ([`Isa::Mask`]). Every form gives the same lanes: a mask is only ever
+/// made by a compare and read by a select or [`LaneMask::any`].
+pub trait LaneMask<const N: usize>: Copy {
+    /// `f(a, b)` per lane.
+    fn test(a: [f32; N], b: [f32; N], f: impl Fn(f32, f32) -> bool) -> Self;
+    /// Both, per lane.
+    fn and(self, other: Self) -> Self;
+    /// Either, per lane.
+    fn or(self, other: Self) -> Self;
+    /// The negation, per lane.
+    fn not(self) -> Self;
+    /// Whether any lane is set.
+    fn any(self) -> bool;
+    /// `if self { if_true } else { if_false }`, per lane.
+    fn select(self, if_true: [f32; N], if_false: [f32; N]) -> [f32; N];
+}
+
+/// A `bool` per lane: AVX-512 keeps these in its mask registers, which its compares write
+/// and its blends read.
+#[derive(Clone, Copy, Debug)]
+pub struct BoolMask<const N: usize>([bool; N]);
+
+impl<const N: usize> LaneMask<N> for BoolMask<N> {
+    #[inline(always)]
+    fn test(a: [f32; N], b: [f32; N], f: impl Fn(f32, f32) -> bool) -> Self {
+        let mut out = [false; N];
+        for ((m, a), b) in out.iter_mut().zip(a).zip(b) {
+            *m = f(a, b);
+        }
+        BoolMask(out)
+    }
 
     #[inline(always)]
-    fn test(self, rhs: Self, f: impl Fn(f32, f32) -> bool) -> [bool; N] {
-        let mut out = [false; N];
-        for ((m, a), b) in out.iter_mut().zip(self.lanes).zip(rhs.lanes) {
-            *m = f(a, b);
+    fn and(self, other: Self) -> Self {
+        let mut out = self.0;
+        for (m, b) in out.iter_mut().zip(other.0) {
+            *m &= b;
+        }
+        BoolMask(out)
+    }
+
+    #[inline(always)]
+    fn or(self, other: Self) -> Self {
+        let mut out = self.0;
+        for (m, b) in out.iter_mut().zip(other.0) {
+            *m |= b;
+        }
+        BoolMask(out)
+    }
+
+    #[inline(always)]
+    fn not(self) -> Self {
+        let mut out = self.0;
+        for m in &mut out {
+            *m = !*m;
+        }
+        BoolMask(out)
+    }
+
+    #[inline(always)]
+    fn any(self) -> bool {
+        self.0.iter().any(|&m| m)
+    }
+
+    #[inline(always)]
+    fn select(self, if_true: [f32; N], if_false: [f32; N]) -> [f32; N] {
+        let mut out = if_false;
+        for ((lane, t), m) in out.iter_mut().zip(if_true).zip(self.0) {
+            *lane = <f32 as Lane>::select(m, t, *lane);
+        }
+        out
+    }
+}
+
+/// All ones or all zeros per lane: what SSE, AVX2 and NEON compares write and their
+/// blends (or `and`, `andnot`, `or`) read. A select moves each lane's bits unchanged, as
+/// the scalar select does.
+#[derive(Clone, Copy, Debug)]
+pub struct BitMask<const N: usize>([u32; N]);
+
+impl<const N: usize> LaneMask<N> for BitMask<N> {
+    #[inline(always)]
+    fn test(a: [f32; N], b: [f32; N], f: impl Fn(f32, f32) -> bool) -> Self {
+        let mut out = [0u32; N];
+        for ((m, a), b) in out.iter_mut().zip(a).zip(b) {
+            *m = if f(a, b) { u32::MAX } else { 0 };
+        }
+        BitMask(out)
+    }
+
+    #[inline(always)]
+    fn and(self, other: Self) -> Self {
+        let mut out = self.0;
+        for (m, b) in out.iter_mut().zip(other.0) {
+            *m &= b;
+        }
+        BitMask(out)
+    }
+
+    #[inline(always)]
+    fn or(self, other: Self) -> Self {
+        let mut out = self.0;
+        for (m, b) in out.iter_mut().zip(other.0) {
+            *m |= b;
+        }
+        BitMask(out)
+    }
+
+    #[inline(always)]
+    fn not(self) -> Self {
+        let mut out = self.0;
+        for m in &mut out {
+            *m = !*m;
+        }
+        BitMask(out)
+    }
+
+    #[inline(always)]
+    fn any(self) -> bool {
+        // A reduction without an early exit, which vectorizes to one test.
+        self.0.iter().fold(0, |acc, &m| acc | m) != 0
+    }
+
+    #[inline(always)]
+    fn select(self, if_true: [f32; N], if_false: [f32; N]) -> [f32; N] {
+        let mut out = if_false;
+        for ((lane, t), m) in out.iter_mut().zip(if_true).zip(self.0) {
+            *lane = f32::from_bits((t.to_bits() & m) | (lane.to_bits() & !m));
         }
         out
     }
@@ -189,7 +330,7 @@ impl<const N: usize, I> Neg for Wide<N, I> {
 }
 
 impl<const N: usize, I: Isa> Lane for Wide<N, I> {
-    type Mask = [bool; N];
+    type Mask = I::Mask<N>;
     const LANES: usize = N;
 
     #[inline(always)]
@@ -256,63 +397,47 @@ impl<const N: usize, I: Isa> Lane for Wide<N, I> {
     }
 
     #[inline(always)]
-    fn lt(self, other: Self) -> [bool; N] {
-        self.test(other, <f32 as Lane>::lt)
+    fn lt(self, other: Self) -> Self::Mask {
+        LaneMask::test(self.lanes, other.lanes, <f32 as Lane>::lt)
     }
 
     #[inline(always)]
-    fn gt(self, other: Self) -> [bool; N] {
-        self.test(other, <f32 as Lane>::gt)
+    fn gt(self, other: Self) -> Self::Mask {
+        LaneMask::test(self.lanes, other.lanes, <f32 as Lane>::gt)
     }
 
     #[inline(always)]
-    fn ge(self, other: Self) -> [bool; N] {
-        self.test(other, <f32 as Lane>::ge)
+    fn ge(self, other: Self) -> Self::Mask {
+        LaneMask::test(self.lanes, other.lanes, <f32 as Lane>::ge)
     }
 
     #[inline(always)]
-    fn is_nan(self) -> [bool; N] {
-        self.test(self, |a, _| a.is_nan())
+    fn is_nan(self) -> Self::Mask {
+        LaneMask::test(self.lanes, self.lanes, |a, _| a.is_nan())
     }
 
     #[inline(always)]
-    fn and(a: [bool; N], b: [bool; N]) -> [bool; N] {
-        let mut out = a;
-        for (m, b) in out.iter_mut().zip(b) {
-            *m &= b;
-        }
-        out
+    fn and(a: Self::Mask, b: Self::Mask) -> Self::Mask {
+        a.and(b)
     }
 
     #[inline(always)]
-    fn or(a: [bool; N], b: [bool; N]) -> [bool; N] {
-        let mut out = a;
-        for (m, b) in out.iter_mut().zip(b) {
-            *m |= b;
-        }
-        out
+    fn or(a: Self::Mask, b: Self::Mask) -> Self::Mask {
+        a.or(b)
     }
 
     #[inline(always)]
-    fn not(mask: [bool; N]) -> [bool; N] {
-        let mut out = mask;
-        for m in &mut out {
-            *m = !*m;
-        }
-        out
+    fn not(mask: Self::Mask) -> Self::Mask {
+        mask.not()
     }
 
     #[inline(always)]
-    fn any(mask: [bool; N]) -> bool {
-        mask.iter().any(|&m| m)
+    fn any(mask: Self::Mask) -> bool {
+        mask.any()
     }
 
     #[inline(always)]
-    fn select(mask: [bool; N], if_true: Self, if_false: Self) -> Self {
-        let mut out = if_false.lanes;
-        for ((lane, t), m) in out.iter_mut().zip(if_true.lanes).zip(mask) {
-            *lane = <f32 as Lane>::select(m, t, *lane);
-        }
-        Self::from_array(out)
+    fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self {
+        Self::from_array(mask.select(if_true.lanes, if_false.lanes))
     }
 }
