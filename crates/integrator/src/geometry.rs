@@ -178,33 +178,40 @@ impl LaneKernel for Clip<'_> {
                 LaneVec3::new(L::load(row(3)), L::load(row(4)), L::load(row(5))),
                 [L::load(row(6)), L::load(row(7)), t_min, t_max],
             );
-            let (mut count, mut range) = ([0usize; MAX_LANES], [None::<(f32, f32)>; MAX_LANES]);
-            let (mut t0s, mut t1s, mut kept) =
-                ([0f32; MAX_LANES], [0f32; MAX_LANES], [0f32; MAX_LANES]);
+            // Per lane: the range the kept objects cover so far (`lo`, `hi`, valid where
+            // `seen`: the first kept object's interval, then each one's union with it,
+            // as `f32::min` and `f32::max` take it), and the candidates kept, in order.
+            let live = u32::MAX >> (32 - group.len());
+            let mut count = [0usize; MAX_LANES];
+            let (mut lo, mut hi) = (L::splat(0.0), L::splat(0.0));
+            let mut seen = L::splat(0.0).gt(L::splat(0.0));
             for (k, &object) in geometry.order.iter().enumerate() {
                 let (t0, t1, keep) = match &geometry.bounds[object as usize] {
                     ObjectBound::Box { aabb, .. } => clip.clip_box_lanes(aabb),
                     ObjectBound::HalfSpace(h) => clip.clip_half_space_lanes(h),
                     ObjectBound::Everywhere => (t_min, t_max, L::splat(0.0).lt(L::splat(1.0))),
                 };
-                t0.store(&mut t0s[..lanes]);
-                t1.store(&mut t1s[..lanes]);
-                L::select(keep, L::splat(1.0), L::splat(0.0)).store(&mut kept[..lanes]);
-                for lane in 0..group.len() {
-                    if kept[lane] != 0.0 {
-                        let (t0, t1) = (t0s[lane], t1s[lane]);
-                        range[lane] =
-                            Some(range[lane].map_or((t0, t1), |(a, b)| (a.min(t0), b.max(t1))));
-                        clipped[lane * objects + count[lane]] = k as u32;
-                        count[lane] += 1;
-                    }
+                lo = L::select(keep, L::select(seen, lo.min(t0), t0), lo);
+                hi = L::select(keep, L::select(seen, hi.max(t1), t1), hi);
+                seen = L::or(seen, keep);
+                let mut kept = L::bits(keep) & live;
+                while kept != 0 {
+                    let lane = kept.trailing_zeros() as usize;
+                    kept &= kept - 1;
+                    clipped[lane * objects + count[lane]] = k as u32;
+                    count[lane] += 1;
                 }
             }
+            let (mut los, mut his) = ([0f32; MAX_LANES], [0f32; MAX_LANES]);
+            lo.store(&mut los[..lanes]);
+            hi.store(&mut his[..lanes]);
+            let seen = L::bits(seen);
             for (lane, &(tag, ray, params)) in batch.queued[group].iter().enumerate() {
-                let Some((t_min, t_max)) = range[lane] else {
+                if seen >> lane & 1 == 0 {
                     batch.misses.push(tag);
                     continue;
-                };
+                }
+                let (t_min, t_max) = (los[lane], his[lane]);
                 let first = batch.candidates.len() as u32;
                 let own = &clipped[lane * objects..lane * objects + count[lane]];
                 batch.candidates.extend_from_slice(own);

@@ -343,13 +343,18 @@ impl<F: StreamField> LaneKernel for RelaxedStream<'_, F> {
     fn run<L: Lane>(mut self) {
         let lanes = L::LANES.min(MAX_LANES);
         let mut rows = [[0f32; MAX_LANES]; ROWS];
-        let mut flight = [None::<usize>; MAX_LANES];
+        let mut flight = [0usize; MAX_LANES];
+        // The lanes with a ray in flight, lane `i` in bit `i`.
+        let mut flying = 0u32;
         let mut next = 0;
         for (lane, slot) in flight.iter_mut().enumerate().take(lanes) {
-            *slot = self.take(lane, &mut next, &mut rows);
+            if let Some(ray) = self.take(lane, &mut next, &mut rows) {
+                *slot = ray;
+                flying |= 1 << lane;
+            }
         }
         let (mut status, mut t_out) = ([0f32; MAX_LANES], [0f32; MAX_LANES]);
-        while flight[..lanes].iter().any(Option::is_some) {
+        while flying != 0 {
             let row = |i: usize| L::load(&rows[i][..lanes]);
             let origin = LaneVec3::new(row(0), row(1), row(2));
             let dir = LaneVec3::new(row(3), row(4), row(5));
@@ -370,8 +375,11 @@ impl<F: StreamField> LaneKernel for RelaxedStream<'_, F> {
             let (stepped, t_stepped) = state.advance(d, self.omega_max);
             let (standing, t_standing) = state.standing();
             let ended = stepped.gt(L::splat(status::GOING));
-            L::select(ended, stepped, standing).store(&mut status[..lanes]);
+            let lane_status = L::select(ended, stepped, standing);
+            lane_status.store(&mut status[..lanes]);
             L::select(ended, t_stepped, t_standing).store(&mut t_out[..lanes]);
+            // Only the lanes whose ray ended visit their outcome.
+            let mut done = L::bits(lane_status.gt(L::splat(status::GOING))) & flying;
             for (i, v) in [
                 state.t,
                 state.steps,
@@ -385,13 +393,15 @@ impl<F: StreamField> LaneKernel for RelaxedStream<'_, F> {
             {
                 v.store(&mut rows[6 + i][..lanes]);
             }
-            for lane in 0..lanes {
-                let Some(ray) = flight[lane] else {
-                    continue;
-                };
+            while done != 0 {
+                let lane = done.trailing_zeros() as usize;
+                done &= done - 1;
                 if let Some(outcome) = outcome(status[lane], t_out[lane], rows[7][lane]) {
-                    self.out[ray] = outcome;
-                    flight[lane] = self.take(lane, &mut next, &mut rows);
+                    self.out[flight[lane]] = outcome;
+                    match self.take(lane, &mut next, &mut rows) {
+                        Some(ray) => flight[lane] = ray,
+                        None => flying &= !(1 << lane),
+                    }
                 }
             }
         }

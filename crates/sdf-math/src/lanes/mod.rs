@@ -75,6 +75,9 @@ pub trait Lane:
     fn not(mask: Self::Mask) -> Self::Mask;
     /// Whether any lane of `mask` is set.
     fn any(mask: Self::Mask) -> bool;
+    /// The mask as bits, lane `i` in bit `i` (vectors have at most 16 lanes): how a kernel
+    /// visits only the lanes a mask holds.
+    fn bits(mask: Self::Mask) -> u32;
     /// `if mask { if_true } else { if_false }`, per lane.
     fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
 }
@@ -197,6 +200,11 @@ impl Lane for f32 {
     #[inline(always)]
     fn any(mask: bool) -> bool {
         mask
+    }
+
+    #[inline(always)]
+    fn bits(mask: bool) -> u32 {
+        u32::from(mask)
     }
 
     #[inline(always)]

@@ -180,6 +180,8 @@ pub trait LaneMask<const N: usize>: Copy {
     fn not(self) -> Self;
     /// Whether any lane is set.
     fn any(self) -> bool;
+    /// Lane `i` in bit `i`.
+    fn bits(self) -> u32;
     /// `if self { if_true } else { if_false }`, per lane.
     fn select(self, if_true: [f32; N], if_false: [f32; N]) -> [f32; N];
 }
@@ -229,6 +231,11 @@ impl<const N: usize> LaneMask<N> for BoolMask<N> {
     #[inline(always)]
     fn any(self) -> bool {
         self.0.iter().any(|&m| m)
+    }
+
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        (self.0.iter().enumerate()).fold(0, |acc, (i, &m)| acc | (u32::from(m) << i))
     }
 
     #[inline(always)]
@@ -288,6 +295,11 @@ impl<const N: usize> LaneMask<N> for BitMask<N> {
     fn any(self) -> bool {
         // A reduction without an early exit, which vectorizes to one test.
         self.0.iter().fold(0, |acc, &m| acc | m) != 0
+    }
+
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        (self.0.iter().enumerate()).fold(0, |acc, (i, &m)| acc | ((m >> 31) << i))
     }
 
     #[inline(always)]
@@ -434,6 +446,11 @@ impl<const N: usize, I: Isa> Lane for Wide<N, I> {
     #[inline(always)]
     fn any(mask: Self::Mask) -> bool {
         mask.any()
+    }
+
+    #[inline(always)]
+    fn bits(mask: Self::Mask) -> u32 {
+        mask.bits()
     }
 
     #[inline(always)]
