@@ -191,8 +191,8 @@ fn shade(
     }
 }
 
-/// Radiance arriving along each of `camera_rays` (sample `ids[i]` for ray `i`), estimated
-/// by one path each, into `out` (cleared first).
+/// Radiance arriving along each of `camera_rays` (sample `ids[i]` for ray `i`, its numbers
+/// drawn from `samplers[i]`), estimated by one path each, into `out` (cleared first).
 ///
 /// The paths advance together, a vertex at a time: their rays are traced as one stream,
 /// then each is shaded, then their shadow rays are traced as another stream, then each
@@ -204,7 +204,7 @@ pub(crate) fn radiance_wave(
     estimator: &Estimator<'_>,
     camera_rays: &[Ray],
     ids: &[SampleId],
-    sampler: &mut Sampler,
+    samplers: &mut [Sampler],
     counters: &mut RayCounters,
     scratch: &mut WaveScratch,
     out: &mut Vec<Vec3>,
@@ -257,7 +257,7 @@ pub(crate) fn radiance_wave(
             if path.depth >= settings.max_depth {
                 continue;
             }
-            let u = VertexSample::draw(sampler, ids[i].pixel, ids[i].index, path.depth);
+            let u = VertexSample::draw(&mut samplers[i], ids[i].pixel, ids[i].index, path.depth);
             s.shaded.push(shade(
                 estimator,
                 &lighting,

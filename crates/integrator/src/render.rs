@@ -365,6 +365,9 @@ fn render_tile(
     let mut counters = RayCounters::default();
     let wave = estimator.scene.execution().wave.max(1);
     let (mut ids, mut rays) = (Vec::with_capacity(wave), Vec::with_capacity(wave));
+    // Each path keeps its own copy of the sampler, positioned past its camera dimensions,
+    // so that its vertices are reached from where it stands.
+    let mut samplers = Vec::with_capacity(wave);
     let (mut estimates, mut scratch) = (Vec::with_capacity(wave), WaveScratch::default());
     let camera = &estimator.scene.scene().camera;
     let pixels =
@@ -378,9 +381,11 @@ fn render_tile(
         }
         ids.clear();
         rays.clear();
+        samplers.clear();
         for id in pixel_samples.by_ref().take(wave) {
             sampler.start_pixel_sample(id.pixel, id.index, 0);
             let jitter = sampler.next_2d();
+            samplers.push(sampler.clone());
             debug_assert_eq!(CAMERA_DIMS, 2);
             let film_point = glam::Vec2::new(id.pixel[0] as f32, id.pixel[1] as f32) + jitter;
             rays.push(camera.generate_ray(film_point, w, h));
@@ -390,7 +395,7 @@ fn render_tile(
             estimator,
             &rays,
             &ids,
-            &mut sampler,
+            &mut samplers,
             &mut counters,
             &mut scratch,
             &mut estimates,

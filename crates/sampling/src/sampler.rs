@@ -60,6 +60,10 @@ pub struct Sampler {
     index: u32,
     dimension: u32,
     rng: Pcg32,
+    /// For the independent kind: how far `rng` stands from the start of its pixel's
+    /// stream (`u64::MAX` before any pixel), so that a later dimension of the same
+    /// sample is reached by advancing the difference, not the whole way again.
+    stream_position: u64,
 }
 
 /// splitmix64's output function (Steele, Lea and Flood 2014; constants from
@@ -200,6 +204,7 @@ impl Sampler {
             index: 0,
             dimension: 0,
             rng: Pcg32::new(0, 0),
+            stream_position: u64::MAX,
         };
         sampler.start_pixel_sample([0, 0], 0, 0);
         sampler
@@ -223,6 +228,7 @@ impl Sampler {
     /// Positions the sampler so that the next value is dimension `dimension`
     /// of sample `sample_index` of `pixel` (pbrt-v4 `StartPixelSample`).
     pub fn start_pixel_sample(&mut self, pixel: [u32; 2], sample_index: u32, dimension: u32) {
+        let same_pixel = self.pixel == pixel;
         self.pixel = pixel;
         self.dimension = dimension;
         if self.replicates > 1 && self.kind != SamplerKind::Independent {
@@ -237,13 +243,21 @@ impl Sampler {
             self.index = sample_index;
         }
         if self.kind == SamplerKind::Independent {
-            let key = u64::from(pixel[0]) | (u64::from(pixel[1]) << 32);
-            let stream = mix64(key ^ mix64(self.seed.wrapping_add(0x9e37_79b9_7f4a_7c15)));
-            // pbrt-v4's RNG::SetSequence(seq) is Pcg32::new(MixBits(seq), seq).
-            self.rng = Pcg32::new(mix64(stream), stream);
-            self.rng.advance(
-                u64::from(sample_index) * u64::from(DIMENSIONS_PER_SAMPLE) + u64::from(dimension),
-            );
+            let position =
+                u64::from(sample_index) * u64::from(DIMENSIONS_PER_SAMPLE) + u64::from(dimension);
+            // The stream is the pixel's; a position ahead on it is reached from where the
+            // generator stands (an LCG's jumps compose exactly), which costs a few steps
+            // for the next vertex of a path instead of a jump of `index * 2^16`.
+            if same_pixel && self.stream_position <= position {
+                self.rng.advance(position - self.stream_position);
+            } else {
+                let key = u64::from(pixel[0]) | (u64::from(pixel[1]) << 32);
+                let stream = mix64(key ^ mix64(self.seed.wrapping_add(0x9e37_79b9_7f4a_7c15)));
+                // pbrt-v4's RNG::SetSequence(seq) is Pcg32::new(MixBits(seq), seq).
+                self.rng = Pcg32::new(mix64(stream), stream);
+                self.rng.advance(position);
+            }
+            self.stream_position = position;
         }
     }
 
@@ -252,6 +266,7 @@ impl Sampler {
     #[inline]
     pub fn next_1d(&mut self) -> f32 {
         if self.kind == SamplerKind::Independent {
+            self.stream_position = self.stream_position.wrapping_add(1);
             return (self.rng.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0);
         }
         let value = self.sample_1d();
@@ -554,6 +569,41 @@ mod tests {
         for (d, &v) in values.iter().enumerate() {
             a.start_pixel_sample([3, 4], 5, d as u32);
             assert_eq!(a.next_1d(), v);
+        }
+    }
+
+    /// A sampler that moves along its pixel's stream (the next vertex of a path), back,
+    /// to another sample or to another pixel gives, at every position, what a fresh
+    /// sampler positioned there gives: the independent kind's short advances from where
+    /// it stands are the jump from the stream's start.
+    #[test]
+    fn every_position_gives_the_fresh_samplers_values_whatever_came_before() {
+        let moves: [([u32; 2], u32, u32); 9] = [
+            ([3, 4], 5, 2),
+            ([3, 4], 5, 10),
+            ([3, 4], 5, 18),
+            ([3, 4], 6, 2),
+            ([3, 4], 5, 26),
+            ([3, 4], 5, 4),
+            ([9, 4], 5, 26),
+            ([3, 4], 5, 34),
+            ([3, 4], 63, 65_535),
+        ];
+        for &kind in SamplerKind::ALL {
+            let mut moving = Sampler::for_image(kind, 11, [16, 16], 64);
+            for &(pixel, index, dimension) in &moves {
+                let mut fresh = Sampler::for_image(kind, 11, [16, 16], 64);
+                fresh.start_pixel_sample(pixel, index, dimension);
+                moving.start_pixel_sample(pixel, index, dimension);
+                for _ in 0..3 {
+                    assert_eq!(
+                        moving.next_1d().to_bits(),
+                        fresh.next_1d().to_bits(),
+                        "{kind:?} at {pixel:?}, sample {index}, dimension {dimension}"
+                    );
+                    assert_eq!(moving.next_2d(), fresh.next_2d(), "{kind:?}");
+                }
+            }
         }
     }
 }
