@@ -11,7 +11,7 @@
 
 use std::fmt;
 use std::marker::PhantomData;
-use std::ops::{Add, Div, Mul, Neg, Sub};
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
 use super::{Lane, SimdLevel, Task};
 
@@ -186,100 +186,105 @@ pub trait LaneMask<const N: usize>: Copy {
     fn select(self, if_true: [f32; N], if_false: [f32; N]) -> [f32; N];
 }
 
+/// One lane of a [`Mask`]: how a form holds a boolean, tests it and selects by it.
+pub trait MaskLane:
+    Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self>
+{
+    /// The lane holding `b`.
+    fn from_bool(b: bool) -> Self;
+    /// 1 where set, 0 elsewhere.
+    fn bit(self) -> u32;
+    /// `if self { if_true } else { if_false }`.
+    fn select(self, if_true: f32, if_false: f32) -> f32;
+    /// Whether any of `lanes` is set, in the reduction this form compiles best to.
+    fn any<const N: usize>(lanes: [Self; N]) -> bool;
+}
+
 /// A `bool` per lane: AVX-512 keeps these in its mask registers, which its compares write
 /// and its blends read.
-#[derive(Clone, Copy, Debug)]
-pub struct BoolMask<const N: usize>([bool; N]);
-
-impl<const N: usize> LaneMask<N> for BoolMask<N> {
+impl MaskLane for bool {
     #[inline(always)]
-    fn test(a: [f32; N], b: [f32; N], f: impl Fn(f32, f32) -> bool) -> Self {
-        let mut out = [false; N];
-        for ((m, a), b) in out.iter_mut().zip(a).zip(b) {
-            *m = f(a, b);
-        }
-        BoolMask(out)
+    fn from_bool(b: bool) -> bool {
+        b
     }
 
     #[inline(always)]
-    fn and(self, other: Self) -> Self {
-        let mut out = self.0;
-        for (m, b) in out.iter_mut().zip(other.0) {
-            *m &= b;
-        }
-        BoolMask(out)
+    fn bit(self) -> u32 {
+        u32::from(self)
     }
 
     #[inline(always)]
-    fn or(self, other: Self) -> Self {
-        let mut out = self.0;
-        for (m, b) in out.iter_mut().zip(other.0) {
-            *m |= b;
-        }
-        BoolMask(out)
+    fn select(self, if_true: f32, if_false: f32) -> f32 {
+        <f32 as Lane>::select(self, if_true, if_false)
     }
 
     #[inline(always)]
-    fn not(self) -> Self {
-        let mut out = self.0;
-        for m in &mut out {
-            *m = !*m;
-        }
-        BoolMask(out)
-    }
-
-    #[inline(always)]
-    fn any(self) -> bool {
-        self.0.iter().any(|&m| m)
-    }
-
-    #[inline(always)]
-    fn bits(self) -> u32 {
-        (self.0.iter().enumerate()).fold(0, |acc, (i, &m)| acc | (u32::from(m) << i))
-    }
-
-    #[inline(always)]
-    fn select(self, if_true: [f32; N], if_false: [f32; N]) -> [f32; N] {
-        let mut out = if_false;
-        for ((lane, t), m) in out.iter_mut().zip(if_true).zip(self.0) {
-            *lane = <f32 as Lane>::select(m, t, *lane);
-        }
-        out
+    fn any<const N: usize>(lanes: [bool; N]) -> bool {
+        lanes.iter().any(|&m| m)
     }
 }
 
 /// All ones or all zeros per lane: what SSE, AVX2 and NEON compares write and their
 /// blends (or `and`, `andnot`, `or`) read. A select moves each lane's bits unchanged, as
 /// the scalar select does.
-#[derive(Clone, Copy, Debug)]
-pub struct BitMask<const N: usize>([u32; N]);
+impl MaskLane for u32 {
+    #[inline(always)]
+    fn from_bool(b: bool) -> u32 {
+        if b { u32::MAX } else { 0 }
+    }
 
-impl<const N: usize> LaneMask<N> for BitMask<N> {
+    #[inline(always)]
+    fn bit(self) -> u32 {
+        self >> 31
+    }
+
+    #[inline(always)]
+    fn select(self, if_true: f32, if_false: f32) -> f32 {
+        f32::from_bits((if_true.to_bits() & self) | (if_false.to_bits() & !self))
+    }
+
+    #[inline(always)]
+    fn any<const N: usize>(lanes: [u32; N]) -> bool {
+        // A reduction without an early exit, which vectorizes to one test.
+        lanes.iter().fold(0, |acc, &m| acc | m) != 0
+    }
+}
+
+/// `N` lanes of a [`MaskLane`] form, each operation lane by lane.
+#[derive(Clone, Copy, Debug)]
+pub struct Mask<T, const N: usize>([T; N]);
+
+/// The mask form of AVX-512.
+pub type BoolMask<const N: usize> = Mask<bool, N>;
+/// The mask form of SSE, AVX2, NEON and portable code.
+pub type BitMask<const N: usize> = Mask<u32, N>;
+
+impl<T: MaskLane, const N: usize> LaneMask<N> for Mask<T, N> {
     #[inline(always)]
     fn test(a: [f32; N], b: [f32; N], f: impl Fn(f32, f32) -> bool) -> Self {
-        let mut out = [0u32; N];
+        let mut out = [T::from_bool(false); N];
         for ((m, a), b) in out.iter_mut().zip(a).zip(b) {
-            *m = if f(a, b) { u32::MAX } else { 0 };
+            *m = T::from_bool(f(a, b));
         }
-        BitMask(out)
+        Mask(out)
     }
 
     #[inline(always)]
     fn and(self, other: Self) -> Self {
         let mut out = self.0;
         for (m, b) in out.iter_mut().zip(other.0) {
-            *m &= b;
+            *m = *m & b;
         }
-        BitMask(out)
+        Mask(out)
     }
 
     #[inline(always)]
     fn or(self, other: Self) -> Self {
         let mut out = self.0;
         for (m, b) in out.iter_mut().zip(other.0) {
-            *m |= b;
+            *m = *m | b;
         }
-        BitMask(out)
+        Mask(out)
     }
 
     #[inline(always)]
@@ -288,25 +293,24 @@ impl<const N: usize> LaneMask<N> for BitMask<N> {
         for m in &mut out {
             *m = !*m;
         }
-        BitMask(out)
+        Mask(out)
     }
 
     #[inline(always)]
     fn any(self) -> bool {
-        // A reduction without an early exit, which vectorizes to one test.
-        self.0.iter().fold(0, |acc, &m| acc | m) != 0
+        T::any(self.0)
     }
 
     #[inline(always)]
     fn bits(self) -> u32 {
-        (self.0.iter().enumerate()).fold(0, |acc, (i, &m)| acc | ((m >> 31) << i))
+        (self.0.iter().enumerate()).fold(0, |acc, (i, &m)| acc | (m.bit() << i))
     }
 
     #[inline(always)]
     fn select(self, if_true: [f32; N], if_false: [f32; N]) -> [f32; N] {
         let mut out = if_false;
         for ((lane, t), m) in out.iter_mut().zip(if_true).zip(self.0) {
-            *lane = f32::from_bits((t.to_bits() & m) | (lane.to_bits() & !m));
+            *lane = m.select(t, *lane);
         }
         out
     }
