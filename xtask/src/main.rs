@@ -3,7 +3,9 @@
 
 mod compose;
 mod figures;
+mod identical;
 mod memory;
+mod old;
 mod peers;
 mod plot;
 mod pointset_figures;
@@ -113,6 +115,23 @@ enum Command {
         /// new one in every round.
         #[arg(long, value_name = "PATH")]
         old: Option<PathBuf>,
+        /// The old binary built from this commit (once; it is kept under
+        /// target/xtask/old/), so the report can be rerun from a clean clone.
+        #[arg(long, value_name = "REV", conflicts_with = "old")]
+        old_rev: Option<String>,
+    },
+    /// Check that this tree renders every shipped scene bit for bit as
+    /// another build does (mis and mixture, streamed and naive, both
+    /// samplers, 48x48 at 8 spp); fails on any difference. For changes
+    /// meant only as speed-ups.
+    Identical {
+        /// The other lueur binary.
+        #[arg(long, value_name = "PATH", required_unless_present = "old_rev")]
+        old: Option<PathBuf>,
+        /// The other binary built from this commit (kept under
+        /// target/xtask/old/).
+        #[arg(long, value_name = "REV", conflicts_with = "old")]
+        old_rev: Option<String>,
     },
     /// Run a command and print its peak resident set in kB (used by
     /// `memory`, one process per measurement).
@@ -133,7 +152,13 @@ fn main() -> Result<()> {
         Command::Peers { quick } => peers::run(quick),
         Command::Scale { quick } => scale::run(quick),
         Command::Replicates { quick } => replicates::run(quick),
-        Command::Speed { quick, rounds, old } => speed::run(quick, rounds, old.as_deref()),
+        Command::Speed {
+            quick,
+            rounds,
+            old,
+            old_rev,
+        } => speed::run(quick, rounds, old.as_deref(), old_rev.as_deref()),
+        Command::Identical { old, old_rev } => identical::run(old.as_deref(), old_rev.as_deref()),
         Command::MemoryProbe { command } => memory::probe(&command),
     }
 }

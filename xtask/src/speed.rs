@@ -23,6 +23,7 @@ use anyhow::{Context, Result, bail};
 use lueur::sdf_math::SimdLevel;
 
 use crate::memory::build_lueur;
+use crate::old::{self, Old};
 use crate::peers::{SCENE as MITSUBA_SCENE, mitsuba, mitsuba_installed, mitsuba_version};
 use crate::project_root;
 use crate::reference::cache_dir;
@@ -69,12 +70,15 @@ struct Speeds {
     mitsuba: [Vec<f64>; 2],
 }
 
-pub fn run(quick: bool, rounds: Option<u32>, old: Option<&Path>) -> Result<()> {
+pub fn run(
+    quick: bool,
+    rounds: Option<u32>,
+    old_path: Option<&Path>,
+    old_rev: Option<&str>,
+) -> Result<()> {
     let plan = PLANS.pick(quick);
     let rounds = rounds.unwrap_or(plan.rounds);
-    let old = old
-        .map(|p| std::fs::canonicalize(p).with_context(|| format!("--old {}", p.display())))
-        .transpose()?;
+    let old = old::resolve(old_path, old_rev)?;
     let new = build_lueur()?;
     let peer = if !plan.mitsuba {
         Peer::Skipped("not run with --quick")
@@ -94,7 +98,7 @@ pub fn run(quick: bool, rounds: Option<u32>, old: Option<&Path>) -> Result<()> {
         for (scene, s) in scenes.iter().zip(&mut speeds) {
             let mut line = format!("round {round}/{rounds} {scene:<16}");
             if let Some(old) = &old {
-                let speed = time_lueur(old, scene, plan, &work)?;
+                let speed = time_lueur(&old.binary, scene, plan, &work)?;
                 write!(line, "  old {speed:.2}")?;
                 s.old.push(speed);
             }
@@ -116,15 +120,15 @@ pub fn run(quick: bool, rounds: Option<u32>, old: Option<&Path>) -> Result<()> {
     println!("{table}");
     let mut command = format!("cargo xtask speed{} --rounds {rounds}", quick_flag(quick));
     if let Some(old) = &old {
-        write!(command, " --old {}", old.display())?;
+        write!(command, " {}", old.flag)?;
     }
-    let md = report(plan, rounds, &peer, old.as_deref(), &command, &table)?;
+    let md = report(plan, rounds, &peer, old.as_ref(), &command, &table)?;
     write_report(quick, "SPEED.md", &md)?;
     Ok(())
 }
 
 /// The names of `scenes/*.toml`, sorted.
-fn shipped_scenes() -> Result<Vec<String>> {
+pub fn shipped_scenes() -> Result<Vec<String>> {
     let dir = project_root().join("scenes");
     let mut names = Vec::new();
     for entry in std::fs::read_dir(&dir).with_context(|| format!("reading {}", dir.display()))? {
@@ -263,7 +267,7 @@ fn report(
     plan: &Plan,
     rounds: u32,
     peer: &Peer,
-    old: Option<&Path>,
+    old: Option<&Old>,
     command: &str,
     table: &str,
 ) -> Result<String> {
@@ -293,10 +297,9 @@ fn report(
          running on each scene, of old, new, `scalar_rgb` and `llvm_ad_rgb`, those measured, \
          in turn; a cell is the median of the rounds (min-max), and a ratio is taken within each round before \
          its median.\n",
-        old.map_or("was not given (`--old PATH`)".into(), |p| format!(
-            "`{}`",
-            p.display()
-        )),
+        old.map_or("was not given (`--old PATH` or `--old-rev REV`)", |o| o
+            .description
+            .as_str()),
         mitsuba_paragraph(peer),
     )?;
     writeln!(md, "## Machine\n")?;
