@@ -94,17 +94,31 @@ pub fn run(
     let work = cache_dir()?.join("speed");
     std::fs::create_dir_all(&work).with_context(|| format!("creating {}", work.display()))?;
     let mut speeds: Vec<Speeds> = scenes.iter().map(|_| Speeds::default()).collect();
+    // Every level this CPU runs, each forced with `--simd`, on the scene Mitsuba also
+    // renders: a default slower than a narrower level (as on AVX2 before its masks were
+    // fixed) shows in every report.
+    let levels = SimdLevel::available();
+    let mut by_level: Vec<Vec<f64>> = levels.iter().map(|_| Vec::new()).collect();
+    let mut by_level_default = Vec::new();
     for round in 1..=rounds {
         for (scene, s) in scenes.iter().zip(&mut speeds) {
             let mut line = format!("round {round}/{rounds} {scene:<16}");
             if let Some(old) = &old {
-                let speed = time_lueur(&old.binary, scene, plan, &work)?;
+                let speed = time_lueur(&old.binary, scene, plan, &work, None)?;
                 write!(line, "  old {speed:.2}")?;
                 s.old.push(speed);
             }
-            let speed = time_lueur(&new, scene, plan, &work)?;
+            let speed = time_lueur(&new, scene, plan, &work, None)?;
             write!(line, "  new {speed:.2}")?;
             s.new.push(speed);
+            if scene == MITSUBA_SCENE {
+                by_level_default.push(speed);
+                for (&level, speeds) in levels.iter().zip(&mut by_level) {
+                    let speed = time_lueur(&new, scene, plan, &work, Some(level))?;
+                    write!(line, "  {} {speed:.2}", level.name())?;
+                    speeds.push(speed);
+                }
+            }
             if matches!(peer, Peer::Measured(_)) && scene == MITSUBA_SCENE {
                 for (variant, speeds) in VARIANTS.iter().zip(&mut s.mitsuba) {
                     let speed = time_mitsuba(variant, plan, &work)?;
@@ -116,7 +130,9 @@ pub fn run(
         }
     }
     let _ = std::fs::remove_dir_all(&work);
-    let table = table(&scenes, &speeds)?;
+    let mut table = table(&scenes, &speeds)?;
+    table.push('\n');
+    table.push_str(&level_table(&levels, &by_level, &by_level_default, !quick)?);
     println!("{table}");
     let mut command = format!("cargo xtask speed{} --rounds {rounds}", quick_flag(quick));
     if let Some(old) = &old {
@@ -166,10 +182,19 @@ fn lueur_args(scene: &str, plan: &Plan, out: &Path) -> Vec<String> {
     args
 }
 
-/// Runs `bin render` on `scene` and returns its speed from the process's
-/// wall time.
-fn time_lueur(bin: &Path, scene: &str, plan: &Plan, work: &Path) -> Result<f64> {
-    let args = lueur_args(scene, plan, &work.join("lueur.exr"));
+/// Runs `bin render` on `scene`, on SIMD level `simd` if one is given, and
+/// returns its speed from the process's wall time.
+fn time_lueur(
+    bin: &Path,
+    scene: &str,
+    plan: &Plan,
+    work: &Path,
+    simd: Option<SimdLevel>,
+) -> Result<f64> {
+    let mut args = lueur_args(scene, plan, &work.join("lueur.exr"));
+    if let Some(level) = simd {
+        args.extend(["--simd".into(), level.name().into()]);
+    }
     let shown = format!("{} {}", bin.display(), args.join(" "));
     let start = Instant::now();
     let out = Command::new(bin)
@@ -263,6 +288,54 @@ fn table(scenes: &[String], speeds: &[Speeds]) -> Result<String> {
     Ok(t)
 }
 
+/// The speed of each forced level on `MITSUBA_SCENE` against the default's in
+/// the same round, flagging a level faster than the default where `flag` (not
+/// in `--quick` runs, whose renders are too short to rank levels).
+fn level_table(
+    levels: &[SimdLevel],
+    speeds: &[Vec<f64>],
+    default: &[f64],
+    flag: bool,
+) -> Result<String> {
+    let mut t = String::new();
+    let detected = SimdLevel::detect();
+    writeln!(
+        t,
+        "By SIMD level, `{MITSUBA_SCENE}` (`--simd LEVEL`; the default is `{}`):\n",
+        detected.name()
+    )?;
+    writeln!(t, "| level | lanes | M samples/s | level/default |")?;
+    writeln!(t, "|---|---|---|---|")?;
+    let mut faster = Vec::new();
+    for (level, s) in levels.iter().zip(speeds) {
+        let ratio = ratios(s, default);
+        if flag && *level != detected && spread(&ratio).is_some_and(|(median, _, _)| median > 1.05) {
+            faster.push(level.name());
+        }
+        writeln!(
+            t,
+            "| {} | {} | {} | {} |",
+            level.name(),
+            level.lanes(),
+            cell(s, ""),
+            cell(&ratio, "x")
+        )?;
+    }
+    if !faster.is_empty() {
+        writeln!(
+            t,
+            "\n**The default level is not the fastest here**: {} beat it by more than 5%.",
+            faster.join(", ")
+        )?;
+        eprintln!(
+            "warning: on this machine {} ran faster than the default level {}",
+            faster.join(", "),
+            detected.name()
+        );
+    }
+    Ok(t)
+}
+
 fn report(
     plan: &Plan,
     rounds: u32,
@@ -296,7 +369,9 @@ fn report(
          (`cargo build --release -p lueur-cli`), *old* {}. {} Rounds: {rounds}, each \
          running on each scene, of old, new, `scalar_rgb` and `llvm_ad_rgb`, those measured, \
          in turn; a cell is the median of the rounds (min-max), and a ratio is taken within each round before \
-         its median.\n",
+         its median. The table by SIMD level runs the new binary once more per level in each round, \
+         right after its default run on `{MITSUBA_SCENE}`; a level more than 5% faster than the \
+         default is flagged.\n",
         old.map_or("was not given (`--old PATH` or `--old-rev REV`)", |o| o
             .description
             .as_str()),
