@@ -182,6 +182,40 @@ pub fn docs_dir(quick: bool) -> PathBuf {
     }
 }
 
+/// The names of `scenes/*.toml`, sorted.
+pub fn shipped_scenes() -> Result<Vec<String>> {
+    let dir = project_root().join("scenes");
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(&dir).with_context(|| format!("reading {}", dir.display()))? {
+        let path = entry?.path();
+        if path.extension().is_some_and(|e| e == "toml")
+            && let Some(stem) = path.file_stem()
+        {
+            names.push(stem.to_string_lossy().into_owned());
+        }
+    }
+    names.sort();
+    Ok(names)
+}
+
+/// Runs `binary` (a `lueur`) with `args` from the project root; its stderr is
+/// the error if it fails.
+pub fn run_lueur(binary: &Path, args: &[String]) -> Result<()> {
+    let shown = format!("{} {}", binary.display(), args.join(" "));
+    let out = std::process::Command::new(binary)
+        .args(args)
+        .current_dir(project_root())
+        .output()
+        .with_context(|| format!("cannot run {shown}"))?;
+    anyhow::ensure!(
+        out.status.success(),
+        "{shown}: {}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Ok(())
+}
+
 /// Loads `scenes/NAME.toml`.
 pub fn load_scene(name: &str) -> Result<SceneFile> {
     let path = project_root().join("scenes").join(format!("{name}.toml"));

@@ -19,15 +19,15 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use lueur::sdf_math::SimdLevel;
 
 use crate::memory::build_lueur;
 use crate::old::{self, Old};
 use crate::peers::{SCENE as MITSUBA_SCENE, mitsuba, mitsuba_installed, mitsuba_version};
-use crate::project_root;
 use crate::reference::cache_dir;
 use crate::report::{Plans, quick_flag, write_report};
+use crate::{project_root, run_lueur, shipped_scenes};
 
 struct Plan {
     size: u32,
@@ -99,7 +99,6 @@ pub fn run(
     // fixed) shows in every report.
     let levels = SimdLevel::available();
     let mut by_level: Vec<Vec<f64>> = levels.iter().map(|_| Vec::new()).collect();
-    let mut by_level_default = Vec::new();
     for round in 1..=rounds {
         for (scene, s) in scenes.iter().zip(&mut speeds) {
             let mut line = format!("round {round}/{rounds} {scene:<16}");
@@ -112,7 +111,6 @@ pub fn run(
             write!(line, "  new {speed:.2}")?;
             s.new.push(speed);
             if scene == MITSUBA_SCENE {
-                by_level_default.push(speed);
                 for (&level, speeds) in levels.iter().zip(&mut by_level) {
                     let speed = time_lueur(&new, scene, plan, &work, Some(level))?;
                     write!(line, "  {} {speed:.2}", level.name())?;
@@ -131,8 +129,10 @@ pub fn run(
     }
     let _ = std::fs::remove_dir_all(&work);
     let mut table = table(&scenes, &speeds)?;
-    table.push('\n');
-    table.push_str(&level_table(&levels, &by_level, &by_level_default, !quick)?);
+    if let Some(i) = scenes.iter().position(|s| s == MITSUBA_SCENE) {
+        table.push('\n');
+        table.push_str(&level_table(&levels, &by_level, &speeds[i].new, !quick)?);
+    }
     println!("{table}");
     let mut command = format!("cargo xtask speed{} --rounds {rounds}", quick_flag(quick));
     if let Some(old) = &old {
@@ -141,22 +141,6 @@ pub fn run(
     let md = report(plan, rounds, &peer, old.as_ref(), &command, &table)?;
     write_report(quick, "SPEED.md", &md)?;
     Ok(())
-}
-
-/// The names of `scenes/*.toml`, sorted.
-pub fn shipped_scenes() -> Result<Vec<String>> {
-    let dir = project_root().join("scenes");
-    let mut names = Vec::new();
-    for entry in std::fs::read_dir(&dir).with_context(|| format!("reading {}", dir.display()))? {
-        let path = entry?.path();
-        if path.extension().is_some_and(|e| e == "toml")
-            && let Some(stem) = path.file_stem()
-        {
-            names.push(stem.to_string_lossy().into_owned());
-        }
-    }
-    names.sort();
-    Ok(names)
 }
 
 /// Millions of samples per second of a render that took `seconds`.
@@ -195,22 +179,9 @@ fn time_lueur(
     if let Some(level) = simd {
         args.extend(["--simd".into(), level.name().into()]);
     }
-    let shown = format!("{} {}", bin.display(), args.join(" "));
     let start = Instant::now();
-    let out = Command::new(bin)
-        .args(&args)
-        .current_dir(project_root())
-        .output()
-        .with_context(|| format!("cannot run {shown}"))?;
-    let seconds = start.elapsed().as_secs_f64();
-    if !out.status.success() {
-        bail!(
-            "{shown}: {}\n{}",
-            out.status,
-            String::from_utf8_lossy(&out.stderr)
-        );
-    }
-    Ok(m_samples_per_s(plan, seconds))
+    run_lueur(bin, &args)?;
+    Ok(m_samples_per_s(plan, start.elapsed().as_secs_f64()))
 }
 
 /// Runs Mitsuba's `variant` on its scene as `cargo xtask peers` does and
@@ -309,7 +280,8 @@ fn level_table(
     let mut faster = Vec::new();
     for (level, s) in levels.iter().zip(speeds) {
         let ratio = ratios(s, default);
-        if flag && *level != detected && spread(&ratio).is_some_and(|(median, _, _)| median > 1.05) {
+        if flag && *level != detected && spread(&ratio).is_some_and(|(median, _, _)| median > 1.05)
+        {
             faster.push(level.name());
         }
         writeln!(
