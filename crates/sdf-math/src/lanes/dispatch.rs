@@ -120,17 +120,17 @@ impl SimdLevel {
     /// instruction set.
     #[inline]
     pub fn dispatch<K: LaneKernel>(self, kernel: K) -> Result<K::Output, UnavailableLevel> {
-        if !self.is_available() {
-            return Err(UnavailableLevel(self));
-        }
-        Ok(match self {
-            SimdLevel::Scalar => kernel.run::<f32>(),
-            SimdLevel::Portable => kernel.run::<Wide<8, Portable>>(),
+        let output = match self {
+            SimdLevel::Scalar => Some(kernel.run::<f32>()),
+            SimdLevel::Portable => {
+                Portable::within(Run::<K, Wide<8, Portable>>(kernel, PhantomData))
+            }
             SimdLevel::Sse => Sse::within(Run::<K, Wide<4, Sse>>(kernel, PhantomData)),
             SimdLevel::Avx2 => Avx2::within(Run::<K, Wide<8, Avx2>>(kernel, PhantomData)),
             SimdLevel::Avx512 => Avx512::within(Run::<K, Wide<16, Avx512>>(kernel, PhantomData)),
             SimdLevel::Neon => Neon::within(Run::<K, Wide<4, Neon>>(kernel, PhantomData)),
-        })
+        };
+        output.ok_or(UnavailableLevel(self))
     }
 }
 

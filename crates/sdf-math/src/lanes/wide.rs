@@ -24,9 +24,12 @@ pub trait Isa: Copy + fmt::Debug + 'static {
     /// converted between the two (AVX2 converting `bool`s at every select cost a fifth of
     /// a render).
     type Mask<const N: usize>: LaneMask<N>;
-    /// Runs `task` in a function compiled with this instruction set's target features, or
-    /// as plain code where the CPU lacks them (the results are the same either way).
-    fn within<T: Task>(task: T) -> T::Output;
+    /// Runs `task` in a function compiled with this instruction set's target features;
+    /// `None`, without running it, where the CPU lacks them. No plain-code copy of the task
+    /// is kept for that case: every kernel is inlined whole into each copy, so a copy per
+    /// level that never runs would cost build time (about half of each kernel's
+    /// optimisation) and nothing else.
+    fn within<T: Task>(task: T) -> Option<T::Output>;
 }
 
 /// No target features beyond the compilation target's own (SSE2 on x86_64, NEON on
@@ -54,8 +57,8 @@ impl Isa for Portable {
     const LEVEL: SimdLevel = SimdLevel::Portable;
     type Mask<const N: usize> = BitMask<N>;
     #[inline(always)]
-    fn within<T: Task>(task: T) -> T::Output {
-        task.run()
+    fn within<T: Task>(task: T) -> Option<T::Output> {
+        Some(task.run())
     }
 }
 
@@ -82,14 +85,16 @@ macro_rules! pulp_isa {
             const LEVEL: SimdLevel = SimdLevel::$level;
             type Mask<const N: usize> = $mask<N>;
             #[inline(always)]
-            fn within<T: Task>(task: T) -> T::Output {
+            fn within<T: Task>(task: T) -> Option<T::Output> {
                 #[cfg($arch)]
                 {
                     if let Some(token) = <$token>::try_new() {
-                        return token.vectorize(Pulp(task));
+                        return Some(token.vectorize(Pulp(task)));
                     }
                 }
-                task.run()
+                #[cfg(not($arch))]
+                let _ = task;
+                None
             }
         }
     };
