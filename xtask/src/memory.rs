@@ -77,22 +77,32 @@ fn peak_rss_mb(program: &Path, args: &[String]) -> Result<(f64, f64)> {
     Ok((kb * 1024.0 / 1e6, secs))
 }
 
-/// Builds the release `lueur` (`cargo build --release -p lueur-cli`) and
-/// returns its path, under `$CARGO_TARGET_DIR` when that is set.
+/// Builds this tree's release `lueur` (`cargo build --release -p lueur-cli`)
+/// and returns its path, under `$CARGO_TARGET_DIR` when that is set.
 pub fn build_lueur() -> Result<PathBuf> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .args(["build", "--release", "-p", "lueur-cli"])
-        .current_dir(project_root())
-        .status()
-        .context("cannot run cargo build")?;
-    ensure!(
-        status.success(),
-        "cargo build --release -p lueur-cli failed"
-    );
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map_or_else(|| project_root().join("target"), PathBuf::from);
-    Ok(target.join("release").join("lueur"))
+    build_lueur_from(&project_root(), &target, &[])
+}
+
+/// Builds the release `lueur` of the workspace at `root` into the target
+/// directory `target` (`cargo build --release -p lueur-cli`, then `extra`)
+/// and returns its path.
+pub fn build_lueur_from(root: &Path, target: &Path, extra: &[&str]) -> Result<PathBuf> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let mut args = vec!["build", "--release", "-p", "lueur-cli"];
+    args.extend(extra);
+    let shown = format!("cargo {} in {}", args.join(" "), root.display());
+    let status = Command::new(cargo)
+        .args(&args)
+        .current_dir(root)
+        .env("CARGO_TARGET_DIR", target)
+        .status()
+        .with_context(|| format!("cannot run {shown}"))?;
+    ensure!(status.success(), "{shown} failed");
+    let binary = target.join("release").join("lueur");
+    ensure!(binary.is_file(), "{shown} made no {}", binary.display());
+    Ok(binary)
 }
 
 pub fn run(quick: bool) -> Result<()> {

@@ -16,6 +16,7 @@ use std::process::{Command, Stdio};
 
 use anyhow::{Context, Result, bail, ensure};
 
+use crate::memory::build_lueur_from;
 use crate::project_root;
 use crate::reference::cache_dir;
 
@@ -97,24 +98,8 @@ fn build_at(commit: &str) -> Result<PathBuf> {
         &commit[..12],
         dir.display()
     );
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .args(["build", "--release", "--locked", "-p", "lueur-cli"])
-        .current_dir(&source)
-        .env("CARGO_TARGET_DIR", dir.join("target"))
-        .status()
-        .context("cannot run cargo build")?;
-    ensure!(
-        status.success(),
-        "building commit {commit} (`cargo build --release --locked -p lueur-cli` in {}) failed",
-        source.display()
-    );
-    ensure!(
-        binary.is_file(),
-        "the build of commit {commit} made no {}",
-        binary.display()
-    );
-    Ok(binary)
+    build_lueur_from(&source, &dir.join("target"), &["--locked"])
+        .with_context(|| format!("building commit {commit}"))
 }
 
 /// Writes the tree of `commit` into `into`: `git archive` piped to `tar`.
