@@ -4,6 +4,7 @@
 mod compose;
 mod figures;
 mod identical;
+mod instructions;
 mod memory;
 mod old;
 mod peers;
@@ -133,6 +134,22 @@ enum Command {
         #[arg(long, value_name = "REV", conflicts_with = "old")]
         old_rev: Option<String>,
     },
+    /// Count the instructions lueur executes per sample on each shipped
+    /// scene with valgrind's callgrind (the same in every run, unlike times),
+    /// against another build where given, and where they go; writes
+    /// docs/INSTRUCTIONS.md. Needs valgrind.
+    Instructions {
+        /// 16x16 at 3 spp: checks the pipeline.
+        #[arg(long)]
+        quick: bool,
+        /// Another lueur binary, counted the same way.
+        #[arg(long, value_name = "PATH")]
+        old: Option<PathBuf>,
+        /// The other binary built from this commit (kept under
+        /// target/xtask/old/).
+        #[arg(long, value_name = "REV", conflicts_with = "old")]
+        old_rev: Option<String>,
+    },
     /// Run a command and print its peak resident set in kB (used by
     /// `memory`, one process per measurement).
     #[command(hide = true)]
@@ -159,6 +176,11 @@ fn main() -> Result<()> {
             old_rev,
         } => speed::run(quick, rounds, old.as_deref(), old_rev.as_deref()),
         Command::Identical { old, old_rev } => identical::run(old.as_deref(), old_rev.as_deref()),
+        Command::Instructions {
+            quick,
+            old,
+            old_rev,
+        } => instructions::run(quick, old.as_deref(), old_rev.as_deref()),
         Command::MemoryProbe { command } => memory::probe(&command),
     }
 }

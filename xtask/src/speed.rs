@@ -392,7 +392,7 @@ fn machine(md: &mut String, peer: &Peer, command: &str) -> Result<()> {
 }
 
 /// The first `model name` of `/proc/cpuinfo`, where there is one.
-fn cpu_model() -> String {
+pub(crate) fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|info| {
@@ -434,7 +434,7 @@ fn simd_features() -> String {
 }
 
 /// `git describe --always --dirty` of the project, or "unknown".
-fn commit() -> String {
+pub(crate) fn commit() -> String {
     Command::new("git")
         .args(["describe", "--always", "--dirty"])
         .current_dir(project_root())
