@@ -206,7 +206,10 @@ fn callgrind(
     let streams = String::from_utf8_lossy(&out.stdout)
         .lines()
         .find_map(|l| l.trim().strip_prefix("ray streams on"))
-        .map_or_else(|| "not reported".to_owned(), |s| s.trim().to_owned());
+        .map_or_else(
+            || "not reported".to_owned(),
+            |s| s.split_whitespace().collect::<Vec<_>>().join(" "),
+        );
     let text = std::fs::read_to_string(&counts)
         .with_context(|| format!("reading {}", counts.display()))?;
     let profile = parse(&text)?;
