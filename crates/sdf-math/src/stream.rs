@@ -291,9 +291,9 @@ impl<F: StreamField> RelaxedStream<'_, F> {
     /// stores into `rows` reach the next step's vector loads of them, and the optimiser
     /// forwards the stored lanes into those loads, splitting every row into pieces put
     /// back together with shuffles at every step, refill or not. Out of line, the kernel
-    /// loads each row whole: 632 instructions per step became 202, and cornell-spheres'
-    /// instructions per sample fell by 10% (`cargo xtask instructions`). What the kernel
-    /// gives up is one call per ray, which needs no vector instructions.
+    /// loads each row whole: a step takes about 200 instructions on AVX2 against 630
+    /// inlined (docs/PERFORMANCE.md, "Instructions per sample"), for one call per ray,
+    /// whose work needs no vector instruction.
     #[inline(never)]
     fn take(
         &mut self,
