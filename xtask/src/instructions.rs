@@ -35,7 +35,7 @@ use crate::memory::build_lueur;
 use crate::old::{self, Old};
 use crate::reference::cache_dir;
 use crate::report::{Plans, quick_flag, write_report};
-use crate::speed::{commit, cpu_model};
+use crate::speed::{MAX_DEPTH, commit, cpu_model, issue_18_render};
 use crate::{project_root, shipped_scenes};
 
 struct Plan {
@@ -58,8 +58,6 @@ const PLANS: Plans<Plan> = Plans {
         top: 5,
     },
 };
-
-const MAX_DEPTH: u32 = 8;
 
 /// The function callgrind counts inside (`--toggle-collect`): the render's
 /// passes, with their tiles, paths and film merges, and not the start, the
@@ -159,28 +157,8 @@ fn callgrind(
 ) -> Result<(Profile, String)> {
     let counts = work.join("callgrind.out");
     let image = work.join("image.exr");
-    let (size, spp, depth) = (size.to_string(), spp.to_string(), MAX_DEPTH.to_string());
-    let scene_path = format!("scenes/{scene}.toml");
-    let lueur_args = [
-        "render",
-        &scene_path,
-        "--width",
-        &size,
-        "--height",
-        &size,
-        "--spp",
-        &spp,
-        "--max-depth",
-        &depth,
-        "--strategy",
-        "mis",
-        "--sampler",
-        "independent",
-        "-t",
-        "1",
-        "--stats",
-        "-o",
-    ];
+    let mut lueur_args = issue_18_render(scene, size, spp, 1);
+    lueur_args.extend(["--stats".into(), "-o".into(), image.display().to_string()]);
     let out = Command::new("valgrind")
         .args([
             "--tool=callgrind",
@@ -190,8 +168,7 @@ fn callgrind(
         .arg(format!("--toggle-collect={RENDER}"))
         .arg(format!("--callgrind-out-file={}", counts.display()))
         .arg(binary)
-        .args(lueur_args)
-        .arg(&image)
+        .args(&lueur_args)
         .current_dir(project_root())
         .output()
         .with_context(|| format!("cannot run valgrind on {}", binary.display()))?;

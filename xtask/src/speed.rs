@@ -51,7 +51,7 @@ const PLANS: Plans<Plan> = Plans {
     },
 };
 
-const MAX_DEPTH: u32 = 8;
+pub(crate) const MAX_DEPTH: u32 = 8;
 const THREADS: u32 = 2;
 const VARIANTS: [&str; 2] = ["scalar_rgb", "llvm_ad_rgb"];
 
@@ -150,19 +150,27 @@ fn m_samples_per_s(plan: &Plan, seconds: f64) -> f64 {
 
 /// The `lueur` arguments of one measured render, run from the project root.
 fn lueur_args(scene: &str, plan: &Plan, out: &Path) -> Vec<String> {
+    let mut args = issue_18_render(scene, plan.size, plan.spp, THREADS);
+    args.extend(["-q".into(), "-o".into(), out.display().to_string()]);
+    args
+}
+
+/// `lueur render` of shipped scene `scene` in issue 18's configuration (`mis`,
+/// independent samples, max_depth [`MAX_DEPTH`]) at `size` x `size` and `spp`, on
+/// `threads` threads, run from the project root; the output flags are the caller's.
+pub(crate) fn issue_18_render(scene: &str, size: u32, spp: u32, threads: u32) -> Vec<String> {
     let mut args: Vec<String> = vec!["render".into(), format!("scenes/{scene}.toml")];
     for (flag, value) in [
-        ("--width", plan.size.to_string()),
-        ("--height", plan.size.to_string()),
-        ("--spp", plan.spp.to_string()),
+        ("--width", size.to_string()),
+        ("--height", size.to_string()),
+        ("--spp", spp.to_string()),
         ("--max-depth", MAX_DEPTH.to_string()),
         ("--strategy", "mis".into()),
         ("--sampler", "independent".into()),
-        ("-t", THREADS.to_string()),
+        ("-t", threads.to_string()),
     ] {
         args.extend([flag.into(), value]);
     }
-    args.extend(["-q".into(), "-o".into(), out.display().to_string()]);
     args
 }
 
