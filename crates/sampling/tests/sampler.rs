@@ -175,3 +175,57 @@ const GOLDEN: [u32; 5] = [
     0x3f28_4a02,
     0x3f1b_11cf,
 ];
+
+/// The stability promise for every kind, not only the independent one: a digest (FNV-1a
+/// over the bits) of 1D and 2D values at scattered pixels, sample indices and dimensions,
+/// with one and with three replicates. A faster way to compute a kind's values must
+/// leave its digest as it is.
+#[test]
+fn golden_digests_of_every_kind() {
+    let digest = |kind: SamplerKind, replicates: u32| {
+        let mut sampler = Sampler::for_render(kind, 0xdead_beef, [640, 480], 64, replicates);
+        let mut h = 0xcbf2_9ce4_8422_2325u64;
+        let mut eat = |x: f32| {
+            h ^= u64::from(x.to_bits());
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        };
+        for pixel in [[0, 0], [1, 0], [3, 5], [639, 479], [200, 17]] {
+            for index in [0, 1, 2, 5, 31, 63] {
+                for dimension in [0, 1, 2, 5, 9, 17, 40, 255] {
+                    sampler.start_pixel_sample(pixel, index, dimension);
+                    eat(sampler.next_1d());
+                    let u = sampler.next_2d();
+                    eat(u.x);
+                    eat(u.y);
+                    eat(sampler.next_1d());
+                }
+            }
+        }
+        h
+    };
+    let got: Vec<(String, u64, u64)> = SamplerKind::ALL
+        .iter()
+        .map(|&kind| (kind.to_string(), digest(kind, 1), digest(kind, 3)))
+        .collect();
+    let expected: Vec<(String, u64, u64)> = GOLDEN_DIGESTS
+        .iter()
+        .map(|&(name, one, three)| (name.to_string(), one, three))
+        .collect();
+    assert_eq!(got, expected, "{got:#x?}");
+}
+
+/// Every kind's digests, which must never change (see [`golden_values`]).
+const GOLDEN_DIGESTS: [(&str, u64, u64); 12] = [
+    ("independent", 0xc2c8c1318fa10877, 0xc2c8c1318fa10877),
+    ("stratified", 0x2228afd41c734394, 0xaec88ad0db0eb7f6),
+    ("lhs", 0x18da8cb5331117af, 0xd9f57a43bdfecc7f),
+    ("cmj", 0xc5cd2a5bda32e629, 0x840b24c9b0b24879),
+    ("halton", 0x2f20f2259f9d7d4b, 0x2c642bca41d288a0),
+    ("halton-owen", 0xde96a9965f1a8b55, 0xf5024ac94b211cba),
+    ("sobol", 0xd4d44cbf31ba8e25, 0x54f0121deed28e25),
+    ("sobol-xor", 0xc5fa021503b440b2, 0x08e124f07e0ee129),
+    ("sobol-owen", 0x309ff53b71c59f8e, 0xa6a771adf68d4ef2),
+    ("zsobol", 0xec1bd70437ca6c1e, 0x118eddba9e24fee2),
+    ("r2", 0x6d6909cd47f47b40, 0x0a193238c7511832),
+    ("pmj02", 0x755d00e4b799bb63, 0xa045630f0a223d60),
+];
