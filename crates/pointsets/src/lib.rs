@@ -74,7 +74,7 @@ pub use pmj02::pmj02_u32;
 pub use poisson::{poisson_disk_max_radius, toroidal_distance};
 pub use sobol::{
     SOBOL_MAX_DIMENSIONS, laine_karras_permutation, nested_uniform_scramble, sobol_owen_u32,
-    sobol_u32,
+    sobol_u32, sobol_u32_at_reversed_index,
 };
 pub use spectrum::{RadialSpectrum, radial_power_spectrum};
 pub use stratified::strata_shape;

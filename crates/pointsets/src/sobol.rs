@@ -41,34 +41,48 @@ static NIBBLES: LazyLock<Vec<[[u32; 16]; 8]>> = LazyLock::new(|| nibble_tables(|
 static REVERSED: LazyLock<Vec<[[u32; 16]; 8]>> =
     LazyLock::new(|| nibble_tables(|v, k| v[31 - k].reverse_bits()));
 
+/// Dimension 1's matrix in the bit-reversed *index* domain (the output is not reversed):
+/// `SECOND_AT_REVERSED[q][b]` is the XOR of the columns `31 - (4q + bit)` for the set bits
+/// of `b`, so that it maps `index.reverse_bits()` to `sobol_u32(index, 1)`. An
+/// Owen-scrambled index comes out reversed (Burley 2020), and the padded samplers read
+/// dimensions 0 and 1 there; 512 bytes.
+static SECOND_AT_REVERSED: LazyLock<[[u32; 16]; 8]> =
+    LazyLock::new(|| nibble_table(&MATRICES[1], |v, k| v[31 - k]));
+
 /// Per dimension, `table[q][b]` = XOR of `column(matrix, 4q + bit)` over the
 /// set bits of `b`: the shared construction of [`NIBBLES`] and [`REVERSED`].
 fn nibble_tables(column: impl Fn(&[u32; 32], usize) -> u32) -> Vec<[[u32; 16]; 8]> {
-    MATRICES
-        .iter()
-        .map(|v| {
-            let mut table = [[0u32; 16]; 8];
-            for (q, row) in table.iter_mut().enumerate() {
-                for (b, entry) in row.iter_mut().enumerate() {
-                    *entry = (0..4)
-                        .filter(|bit| (b >> bit) & 1 == 1)
-                        .fold(0, |x, bit| x ^ column(v, 4 * q + bit));
-                }
-            }
-            table
-        })
-        .collect()
+    MATRICES.iter().map(|v| nibble_table(v, &column)).collect()
+}
+
+/// One matrix's nibble table (see [`nibble_tables`]).
+fn nibble_table(v: &[u32; 32], column: impl Fn(&[u32; 32], usize) -> u32) -> [[u32; 16]; 8] {
+    let mut table = [[0u32; 16]; 8];
+    for (q, row) in table.iter_mut().enumerate() {
+        for (b, entry) in row.iter_mut().enumerate() {
+            *entry = (0..4)
+                .filter(|bit| (b >> bit) & 1 == 1)
+                .fold(0, |x, bit| x ^ column(v, 4 * q + bit));
+        }
+    }
+    table
+}
+
+/// The XOR of the table entries the nibbles of `x` select: a matrix product over GF(2)
+/// by eight reads.
+#[inline]
+fn xor_nibbles(table: &[[u32; 16]; 8], x: u32) -> u32 {
+    let mut sum = 0;
+    for (q, row) in table.iter().enumerate() {
+        sum ^= row[((x >> (4 * q)) & 15) as usize];
+    }
+    sum
 }
 
 /// `sobol_u32(r.reverse_bits(), dimension).reverse_bits()`, from tables.
 #[inline]
 fn sobol_reversed(reversed_index: u32, dimension: usize) -> u32 {
-    let table = &REVERSED[dimension];
-    let mut x = 0;
-    for (q, row) in table.iter().enumerate() {
-        x ^= row[((reversed_index >> (4 * q)) & 15) as usize];
-    }
-    x
+    xor_nibbles(&REVERSED[dimension], reversed_index)
 }
 
 /// Parses the Joe–Kuo table format (`d s a m_1 .. m_s` per line, `#`
@@ -130,12 +144,21 @@ fn parse_joe_kuo(text: &str, dims: usize) -> Option<Vec<[u32; 32]>> {
 /// Panics if `dimension >= SOBOL_MAX_DIMENSIONS`.
 #[inline]
 pub fn sobol_u32(index: u32, dimension: usize) -> u32 {
-    let table = &NIBBLES[dimension];
-    let mut x = 0;
-    for (q, row) in table.iter().enumerate() {
-        x ^= row[((index >> (4 * q)) & 15) as usize];
+    xor_nibbles(&NIBBLES[dimension], index)
+}
+
+/// [`sobol_u32`] at the index `reversed_index.reverse_bits()`: where an index is kept
+/// bit-reversed, as nested uniform scrambling of the index leaves it, dimensions 0 (van
+/// der Corput's, which is the bit reversal itself) and 1 need no reversal back. The
+/// other dimensions reverse the index and read [`sobol_u32`].
+/// Panics if `dimension >= SOBOL_MAX_DIMENSIONS`.
+#[inline]
+pub fn sobol_u32_at_reversed_index(reversed_index: u32, dimension: usize) -> u32 {
+    match dimension {
+        0 => reversed_index,
+        1 => xor_nibbles(&SECOND_AT_REVERSED, reversed_index),
+        _ => sobol_u32(reversed_index.reverse_bits(), dimension),
     }
-    x
 }
 
 /// The Laine–Karras permutation with Burley's improved constants: a hash
@@ -223,6 +246,19 @@ mod tests {
         for dim in [0, 1, 2, 17, 255] {
             for index in [0, 1, 2, 3, 255, 256, 0xdead_beef, u32::MAX] {
                 assert_eq!(sobol_u32(index, dim), by_bits(index, dim));
+            }
+        }
+    }
+
+    #[test]
+    fn points_at_reversed_indices_are_the_points() {
+        for dim in [0, 1, 2, 17, 255] {
+            for index in [0, 1, 2, 3, 255, 256, 0xdead_beef, 0x8000_0001, u32::MAX] {
+                assert_eq!(
+                    sobol_u32_at_reversed_index(index.reverse_bits(), dim),
+                    sobol_u32(index, dim),
+                    "dim {dim} index {index}"
+                );
             }
         }
     }

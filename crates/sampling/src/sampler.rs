@@ -6,11 +6,12 @@ use rand_pcg::Pcg32;
 use rand_pcg::rand_core::Rng;
 
 use lueur_pointsets::construct::{
-    PMJ02_TABLE_LEN, PMJ02_TABLES, cmj, hash2, hash3, permute, pmj02_table_point,
+    PMJ02_TABLE_LEN, PMJ02_TABLES, cmj, hash2, permute, pmj02_table_point,
 };
 use lueur_pointsets::{
-    HALTON_MAX_DIMENSIONS, SOBOL_MAX_DIMENSIONS, halton_base, nested_uniform_scramble,
-    owen_scrambled_radical_inverse, radical_inverse, sobol_u32,
+    HALTON_MAX_DIMENSIONS, SOBOL_MAX_DIMENSIONS, halton_base, laine_karras_permutation,
+    nested_uniform_scramble, owen_scrambled_radical_inverse, radical_inverse, sobol_u32,
+    sobol_u32_at_reversed_index,
 };
 
 use crate::SamplerKind;
@@ -59,6 +60,12 @@ pub struct Sampler {
     pixel: [u32; 2],
     index: u32,
     dimension: u32,
+    /// For the hashed kinds: `hash2(replicate_seed, pixel key)`, the part of every
+    /// request's scramble seed ([`Sampler::sequence_hash`]) that a pixel sample shares,
+    /// hashed once when it starts.
+    pixel_hash: u64,
+    /// `index.reverse_bits()`, where the padded Sobol' kinds scramble it.
+    reversed_index: u32,
     rng: Pcg32,
     /// For the independent kind: how far `rng` stands from the start of its pixel's
     /// stream (`u64::MAX` before any pixel), so that a later dimension of the same
@@ -73,6 +80,12 @@ fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
+}
+
+/// The 64-bit key of a pixel that the per-pixel hashes start from.
+#[inline]
+fn pixel_key(pixel: [u32; 2]) -> u64 {
+    u64::from(pixel[0]) | (u64::from(pixel[1]) << 32)
 }
 
 /// A 32-bit binary fraction as an `f32` in `[0, 1)`: its top 24 bits.
@@ -203,6 +216,8 @@ impl Sampler {
             pixel: [0, 0],
             index: 0,
             dimension: 0,
+            pixel_hash: 0,
+            reversed_index: 0,
             rng: Pcg32::new(0, 0),
             stream_position: u64::MAX,
         };
@@ -242,7 +257,10 @@ impl Sampler {
         } else {
             self.index = sample_index;
         }
-        if self.kind == SamplerKind::Independent {
+        if self.kind != SamplerKind::Independent {
+            self.pixel_hash = hash2(self.replicate_seed, pixel_key(pixel));
+            self.reversed_index = self.index.reverse_bits();
+        } else {
             let position =
                 u64::from(sample_index) * u64::from(DIMENSIONS_PER_SAMPLE) + u64::from(dimension);
             // The stream is the pixel's; a position ahead on it is reached from where the
@@ -251,7 +269,7 @@ impl Sampler {
             if same_pixel && self.stream_position <= position {
                 self.rng.advance(position - self.stream_position);
             } else {
-                let key = u64::from(pixel[0]) | (u64::from(pixel[1]) << 32);
+                let key = pixel_key(pixel);
                 let stream = mix64(key ^ mix64(self.seed.wrapping_add(0x9e37_79b9_7f4a_7c15)));
                 // pbrt-v4's RNG::SetSequence(seq) is Pcg32::new(MixBits(seq), seq).
                 self.rng = Pcg32::new(mix64(stream), stream);
@@ -294,20 +312,16 @@ impl Sampler {
     /// indices past `spp` start an independent pattern.
     #[inline]
     fn request_hash(&self) -> u64 {
-        let key = u64::from(self.pixel[0]) | (u64::from(self.pixel[1]) << 32);
         let block = self.index / self.spp;
-        hash2(
-            hash3(self.replicate_seed, key, u64::from(self.dimension)),
-            u64::from(block),
-        )
+        hash2(self.sequence_hash(self.dimension), u64::from(block))
     }
 
     /// Pixel-wide seed of `dimension`, without the index block: for the
-    /// sequences, whose index is used whole.
+    /// sequences, whose index is used whole. It is `hash3(replicate_seed, pixel key,
+    /// dimension)`, its first step done once per pixel sample.
     #[inline]
     fn sequence_hash(&self, dimension: u32) -> u64 {
-        let key = u64::from(self.pixel[0]) | (u64::from(self.pixel[1]) << 32);
-        hash3(self.replicate_seed, key, u64::from(dimension))
+        hash2(self.pixel_hash, u64::from(dimension))
     }
 
     /// Dimension `dimension` of the plain or scrambled Halton or Sobol'
@@ -436,10 +450,12 @@ impl Sampler {
     #[inline]
     fn padded_sobol<const N: usize>(&self) -> [u32; N] {
         let h = self.sequence_hash(self.dimension);
-        let index = nested_uniform_scramble(self.index, h as u32);
+        // The index scrambled is `nested_uniform_scramble(index, h)`, kept bit-reversed (the
+        // scramble's last step undone), where dimensions 0 and 1 read it directly.
+        let index = laine_karras_permutation(self.reversed_index, h as u32);
         let seeds = [(h >> 32) as u32, hash2(h, 1) as u32];
         std::array::from_fn(|k| {
-            let x = sobol_u32(index, k);
+            let x = sobol_u32_at_reversed_index(index, k);
             if self.kind == SamplerKind::SobolXor {
                 x ^ seeds[k]
             } else {
