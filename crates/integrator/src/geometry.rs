@@ -17,10 +17,8 @@ use lueur_scene::{Marching, Object};
 pub(crate) struct Geometry {
     sdfs: Vec<Sdf>,
     lipschitz: f32,
-    /// Per object: what a ray is clipped against before it is marched.
-    bounds: Vec<ObjectBound>,
-    /// Per object: its transforms folded into one affine map, for fast marching.
-    prepared: Vec<PreparedSdf>,
+    /// Per object: its place in [`Geometry::order`], which holds its prepared field.
+    position: Vec<u32>,
     /// Objects evaluated at every point: those without a bounding sphere (planes) and
     /// those no dearer than their bound (spheres), first, so that the running minimum is
     /// small before the culled objects are reached.
@@ -31,7 +29,20 @@ pub(crate) struct Geometry {
     /// (so that a ray's march does not depend on the rays beside it in a vector): the
     /// objects checked without their box first, so that the running minimum is small
     /// when the boxes are checked, then the others, each group in scene order.
-    order: Vec<u32>,
+    order: Vec<Ordered>,
+}
+
+/// An object at its place in [`Geometry::order`], with what the vector kernels read of
+/// it there, so that they walk one array.
+#[derive(Clone, Debug, PartialEq)]
+struct Ordered {
+    object: u32,
+    /// Its transforms folded into one affine map, for fast marching.
+    prepared: PreparedSdf,
+    /// `object` as [`CandidateLanes`] holds it in its lanes (exact in `f32`).
+    id: f32,
+    /// What a ray is clipped against before it is marched.
+    bound: ObjectBound,
 }
 
 /// What a ray is clipped against for one object (see [`Marching::Fast`]).
@@ -185,8 +196,8 @@ impl LaneKernel for Clip<'_> {
             let mut count = [0usize; MAX_LANES];
             let (mut lo, mut hi) = (L::splat(0.0), L::splat(0.0));
             let mut seen = L::splat(0.0).gt(L::splat(0.0));
-            for (k, &object) in geometry.order.iter().enumerate() {
-                let (t0, t1, keep) = match &geometry.bounds[object as usize] {
+            for (k, entry) in geometry.order.iter().enumerate() {
+                let (t0, t1, keep) = match &entry.bound {
                     ObjectBound::Box { aabb, .. } => clip.clip_box_lanes(aabb),
                     ObjectBound::HalfSpace(h) => clip.clip_half_space_lanes(h),
                     ObjectBound::Everywhere => (t_min, t_max, L::splat(0.0).lt(L::splat(1.0))),
@@ -305,7 +316,7 @@ impl StreamField for CandidateLanes<'_> {
                 self.members[k as usize] += 1;
             }
             // A marched ray has at least one candidate.
-            self.first[lane] = self.geometry.order[candidates[0] as usize] as f32;
+            self.first[lane] = self.geometry.order[candidates[0] as usize].id;
         }
     }
 
@@ -315,24 +326,25 @@ impl StreamField for CandidateLanes<'_> {
         let zero = L::splat(0.0);
         let mut d = L::splat(f32::INFINITY);
         let mut nearest = L::load(&self.first[..lanes]);
-        for (k, &object) in self.geometry.order.iter().enumerate() {
-            if self.members[k] == 0 {
+        let order = self.geometry.order.iter();
+        for ((entry, &members), member) in order.zip(&*self.members).zip(&*self.member) {
+            if members == 0 {
                 continue;
             }
-            let mut active = L::load(&self.member[k][..lanes]).gt(zero);
+            let mut active = L::load(&member[..lanes]).gt(zero);
             // The box is at most as far as the object (its contract): where it is already
             // farther than the running minimum, the object cannot lower it.
-            if let ObjectBound::Box { aabb, cull: true } = &self.geometry.bounds[object as usize] {
+            if let ObjectBound::Box { aabb, cull: true } = &entry.bound {
                 let beyond = L::and(d.gt(zero), aabb.distance_squared_lanes(p).ge(d * d));
                 active = L::and(active, L::not(beyond));
                 if !L::any(active) {
                     continue;
                 }
             }
-            let f = self.geometry.prepared[object as usize].distance_lanes(p);
+            let f = entry.prepared.distance_lanes(p);
             let lower = L::and(active, f.lt(d));
             d = L::select(lower, f, d);
-            nearest = L::select(lower, L::splat(object as f32), nearest);
+            nearest = L::select(lower, L::splat(entry.id), nearest);
         }
         nearest.store(&mut self.last[..lanes]);
         d
@@ -367,15 +379,25 @@ impl Geometry {
         }
         let bounds: Vec<ObjectBound> = objects.iter().map(|o| ObjectBound::of(&o.sdf)).collect();
         let boxed = |b: &ObjectBound| matches!(b, ObjectBound::Box { cull: true, .. });
+        let ordered = |object: u32| Ordered {
+            object,
+            prepared: PreparedSdf::new(&objects[object as usize].sdf),
+            id: object as f32,
+            bound: bounds[object as usize],
+        };
         let order = (0..objects.len() as u32)
             .filter(|&i| !boxed(&bounds[i as usize]))
             .chain((0..objects.len() as u32).filter(|&i| boxed(&bounds[i as usize])))
-            .collect();
+            .map(ordered)
+            .collect::<Vec<_>>();
+        let mut position = vec![0; objects.len()];
+        for (k, entry) in order.iter().enumerate() {
+            position[entry.object as usize] = k as u32;
+        }
         Geometry {
             sdfs: objects.iter().map(|o| o.sdf.clone()).collect(),
             lipschitz,
-            bounds,
-            prepared: objects.iter().map(|o| PreparedSdf::new(&o.sdf)).collect(),
+            position,
             always,
             culled,
             order,
@@ -465,7 +487,7 @@ impl Geometry {
 
     /// Object `i`'s field as fast marching evaluates it (its transforms folded).
     pub fn prepared(&self, i: usize) -> &PreparedSdf {
-        &self.prepared[i]
+        &self.order[self.position[i] as usize].prepared
     }
 
     /// The object closest to `p` (after a hit, the one that was hit).
