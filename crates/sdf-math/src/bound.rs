@@ -165,27 +165,31 @@ impl<L: Lane> Slope<L> {
         }
     }
 
-    /// Per axis, the interval `{t : alpha + slope t < 0}` within `[t_min, t_max]`, an
-    /// empty one as `(inf, -inf)` so that it drops out of a hull (the hull of a half-line
-    /// at negative `t` and one at positive `t` is everything, clipped first it is the
-    /// second).
+    /// On axis `axis`, the interval `{t : alpha + slope t < 0}` within `[t_min, t_max]`,
+    /// an empty one as `(inf, -inf)` so that it drops out of a hull (the hull of a
+    /// half-line at negative `t` and one at positive `t` is everything, clipped first it
+    /// is the second).
     #[inline(always)]
-    fn below(&self, alpha: LaneVec3<L>, t_min: L, t_max: L) -> (LaneVec3<L>, LaneVec3<L>) {
-        #[inline(always)]
-        fn axis<L: Lane>(alpha: L, inv: L, rising: L::Mask, t_min: L, t_max: L) -> (L, L) {
-            let root = -alpha * inv;
-            let lo = L::select(rising, t_min, root.max_cmp(t_min));
-            let hi = L::select(rising, root.min_cmp(t_max), t_max);
-            let empty = lo.gt(hi);
-            (
-                L::select(empty, L::splat(f32::INFINITY), lo),
-                L::select(empty, L::splat(f32::NEG_INFINITY), hi),
-            )
-        }
-        let (lx, hx) = axis(alpha.x, self.inv.x, self.rising[0], t_min, t_max);
-        let (ly, hy) = axis(alpha.y, self.inv.y, self.rising[1], t_min, t_max);
-        let (lz, hz) = axis(alpha.z, self.inv.z, self.rising[2], t_min, t_max);
-        (LaneVec3::new(lx, ly, lz), LaneVec3::new(hx, hy, hz))
+    fn below(&self, axis: usize, alpha: L, t_min: L, t_max: L) -> (L, L) {
+        let (inv, rising) = (component(self.inv, axis), self.rising[axis]);
+        let root = -alpha * inv;
+        let lo = L::select(rising, t_min, root.max_cmp(t_min));
+        let hi = L::select(rising, root.min_cmp(t_max), t_max);
+        let empty = lo.gt(hi);
+        (
+            L::select(empty, L::splat(f32::INFINITY), lo),
+            L::select(empty, L::splat(f32::NEG_INFINITY), hi),
+        )
+    }
+}
+
+/// Coordinate `axis` (0, 1 or 2) of `v`.
+#[inline(always)]
+fn component<L: Lane>(v: LaneVec3<L>, axis: usize) -> L {
+    match axis {
+        0 => v.x,
+        1 => v.y,
+        _ => v.z,
     }
 }
 
@@ -320,28 +324,42 @@ impl<L: Lane> RayClipLanes<L> {
     /// meaningful where `kept`.
     #[inline(always)]
     pub fn clip_box_lanes(&self, aabb: &Aabb) -> (L, L, L::Mask) {
-        let (min, max) = (LaneVec3::splat(aabb.min), LaneVec3::splat(aabb.max));
-        // Taken off every plane value: the f32 rounding of the numbers that decide it, per
-        // axis (the origin's coordinate and the box's faces on that axis). Per axis, not
-        // the largest coordinate of all, so that a ray leaving the top of a floor 1e4 wide
-        // is not a candidate for it however close above it starts.
-        let scale = self.origin.abs().max(min.abs()).max(max.abs());
-        let four_eps = L::splat(4.0 * f32::EPSILON);
-        let rounding = LaneVec3::new(four_eps * scale.x, four_eps * scale.y, four_eps * scale.z);
-        let eps_abs = LaneVec3::new(self.eps_abs, self.eps_abs, self.eps_abs);
-        let up = self.origin - max - rounding;
-        let down = min - self.origin - rounding;
-        let [up_abs, up_rel, down_abs, down_rel] = &self.families;
         let (t_min, t_max) = (self.t_min, self.t_max);
-        let (lo_a, hi_a) = up_abs.below(up - eps_abs, t_min, t_max);
-        let (lo_b, hi_b) = up_rel.below(up, t_min, t_max);
-        let (lo_c, hi_c) = down_abs.below(down - eps_abs, t_min, t_max);
-        let (lo_d, hi_d) = down_rel.below(down, t_min, t_max);
-        // Per face the hull of its two sets; over the faces, the intersection.
-        let lo = lo_a.min(lo_b).max(lo_c.min(lo_d));
-        let hi = hi_a.max(hi_b).min(hi_c.max(hi_d));
-        let t0 = lo.max_element().max(t_min);
-        let t1 = hi.min_element().min(t_max);
+        // One axis at a time, each folded into the intersection before the next, so that
+        // what is live at once fits the vector registers (all three axes' sets at once
+        // did not, and were spilled and reloaded). Not a closure: a vector kernel inlines
+        // only what is marked to be inlined.
+        #[inline(always)]
+        fn axis<L: Lane>(clip: &RayClipLanes<L>, aabb: &Aabb, axis: usize) -> (L, L) {
+            let [up_abs, up_rel, down_abs, down_rel] = &clip.families;
+            let (t_min, t_max, eps_abs) = (clip.t_min, clip.t_max, clip.eps_abs);
+            let o = component(clip.origin, axis);
+            let (min, max) = (L::splat(aabb.min[axis]), L::splat(aabb.max[axis]));
+            // Taken off every plane value: the f32 rounding of the numbers that decide it,
+            // per axis (the origin's coordinate and the box's faces on that axis). Per
+            // axis, not the largest coordinate of all, so that a ray leaving the top of a
+            // floor 1e4 wide is not a candidate for it however close above it starts.
+            let scale = o.abs().max_cmp(min.abs()).max_cmp(max.abs());
+            let rounding = L::splat(4.0 * f32::EPSILON) * scale;
+            let up = o - max - rounding;
+            let down = min - o - rounding;
+            let (lo_a, hi_a) = up_abs.below(axis, up - eps_abs, t_min, t_max);
+            let (lo_b, hi_b) = up_rel.below(axis, up, t_min, t_max);
+            let (lo_c, hi_c) = down_abs.below(axis, down - eps_abs, t_min, t_max);
+            let (lo_d, hi_d) = down_rel.below(axis, down, t_min, t_max);
+            // Per face the hull of its two sets; over the faces, the intersection.
+            (
+                lo_a.min_cmp(lo_b).max_cmp(lo_c.min_cmp(lo_d)),
+                hi_a.max_cmp(hi_b).min_cmp(hi_c.max_cmp(hi_d)),
+            )
+        }
+        // Over the axes, as `max_element` and `min_element` take them: `x` with `(y, z)`.
+        let (lo_z, hi_z) = axis(self, aabb, 2);
+        let (lo_y, hi_y) = axis(self, aabb, 1);
+        let (lo_yz, hi_yz) = (lo_y.max_cmp(lo_z), hi_y.min_cmp(hi_z));
+        let (lo_x, hi_x) = axis(self, aabb, 0);
+        let t0 = lo_x.max_cmp(lo_yz).max(t_min);
+        let t1 = hi_x.min_cmp(hi_yz).min(t_max);
         let (t0, t1, kept) = widen(t0, t1, t_min, t_max);
         (
             L::select(self.degenerate, t_min, t0),
