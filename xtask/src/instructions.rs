@@ -20,6 +20,11 @@
 //! function (its own instructions, inlined code included, calls left to the
 //! callee) says where they go.
 //!
+//! Each scene is also counted with its own sampler (what its file says, as
+//! a user's render runs it), the rest of the configuration unchanged: the
+//! sampler's cost never shows with independent samples, and the default one
+//! once took a sixth of a render.
+//!
 //! valgrind runs the program on its own model of the CPU, which has AVX2 and
 //! no AVX-512: the counts are those of the AVX2 path (or narrower) whatever
 //! the machine; the report names the level the streams ran on.
@@ -73,10 +78,21 @@ struct Profile {
     by_function: HashMap<String, u64>,
 }
 
+/// Which sampler a count renders with.
+#[derive(Clone, Copy, PartialEq)]
+enum Sampling {
+    /// Issue 18's: independent samples.
+    Independent,
+    /// The scene file's own.
+    Scene,
+}
+
 /// One binary's counts on one scene.
 struct Counted {
     /// Instructions per sample beyond the first spp.
     per_sample: f64,
+    /// The same with the scene's own sampler, and that sampler's name.
+    own_sampler: (f64, String),
     /// Per function, its own instructions per sample beyond the first spp,
     /// the kernels merged, most first.
     by_function: Vec<(String, f64)>,
@@ -98,14 +114,24 @@ pub fn run(quick: bool, old_path: Option<&Path>, old_rev: Option<&str>) -> Resul
             Some(old) => Some(count(&old.binary, &scene, plan, &work)?),
             None => None,
         };
+        let against = |new: f64, old: Option<f64>| {
+            old.map_or(String::new(), |o| {
+                format!(", old {o:.0} (new/old {:.3})", new / o)
+            })
+        };
         eprintln!(
-            "{scene}: {:.0} instructions per sample{}",
+            "{scene}: {:.0} instructions per sample{}; with {}: {:.0}{}",
             counted_new.per_sample,
-            counted_old.as_ref().map_or(String::new(), |o| format!(
-                ", old {:.0} (new/old {:.3})",
-                o.per_sample,
-                counted_new.per_sample / o.per_sample
-            ))
+            against(
+                counted_new.per_sample,
+                counted_old.as_ref().map(|o| o.per_sample)
+            ),
+            counted_new.own_sampler.1,
+            counted_new.own_sampler.0,
+            against(
+                counted_new.own_sampler.0,
+                counted_old.as_ref().map(|o| o.own_sampler.0)
+            ),
         );
         rows.push((scene, counted_new, counted_old));
     }
@@ -133,31 +159,50 @@ fn valgrind_version() -> Result<String> {
 
 /// Counts `binary` on `scene` at 1 and at `1 + plan.extra` spp.
 fn count(binary: &Path, scene: &str, plan: &Plan, work: &Path) -> Result<Counted> {
-    let (short, _) = callgrind(binary, scene, plan.size, 1, work)?;
-    let (long, streams) = callgrind(binary, scene, plan.size, 1 + plan.extra, work)?;
+    let run = |spp, sampling| callgrind(binary, scene, (plan.size, spp), sampling, work);
+    let (short, _) = run(1, Sampling::Independent)?;
+    let (long, rendered) = run(1 + plan.extra, Sampling::Independent)?;
+    let (own_short, _) = run(1, Sampling::Scene)?;
+    let (own_long, own_rendered) = run(1 + plan.extra, Sampling::Scene)?;
     let samples = f64::from(plan.size) * f64::from(plan.size) * f64::from(plan.extra);
+    let extra =
+        |short: &Profile, long: &Profile| long.total.saturating_sub(short.total) as f64 / samples;
     Ok(Counted {
-        per_sample: long.total.saturating_sub(short.total) as f64 / samples,
+        per_sample: extra(&short, &long),
+        own_sampler: (extra(&own_short, &own_long), own_rendered.sampler),
         by_function: breakdown(&short, &long)
             .into_iter()
             .map(|(f, n)| (f, n as f64 / samples))
             .collect(),
-        streams,
+        streams: rendered.streams,
     })
 }
 
-/// One render under callgrind: what it counted, and the `--stats` line
-/// naming the instruction set of the streams.
+/// What a render said of itself on its standard output.
+struct Rendered {
+    /// The instruction set of the streams, from `--stats`.
+    streams: String,
+    /// The sampler, from the first line (`rendered ... (strategy, sampler) ...`).
+    sampler: String,
+}
+
+/// One render under callgrind: what it counted, and what the render said.
 fn callgrind(
     binary: &Path,
     scene: &str,
-    size: u32,
-    spp: u32,
+    (size, spp): (u32, u32),
+    sampling: Sampling,
     work: &Path,
-) -> Result<(Profile, String)> {
+) -> Result<(Profile, Rendered)> {
     let counts = work.join("callgrind.out");
     let image = work.join("image.exr");
     let mut lueur_args = issue_18_render(scene, size, spp, 1);
+    if sampling == Sampling::Scene {
+        let at = (lueur_args.iter())
+            .position(|a| a == "--sampler")
+            .context("issue 18's render names a sampler")?;
+        lueur_args.drain(at..at + 2);
+    }
     lueur_args.extend(["--stats".into(), "-o".into(), image.display().to_string()]);
     let out = Command::new("valgrind")
         .args([
@@ -180,13 +225,17 @@ fn callgrind(
         lueur_args.join(" "),
         out.status
     );
-    let streams = String::from_utf8_lossy(&out.stdout)
-        .lines()
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let streams = (stdout.lines())
         .find_map(|l| l.trim().strip_prefix("ray streams on"))
         .map_or_else(
             || "not reported".to_owned(),
             |s| s.split_whitespace().collect::<Vec<_>>().join(" "),
         );
+    // The render's own status line goes to standard error, beside valgrind's.
+    let sampler = rendered_sampler(&stderr)
+        .unwrap_or("not reported")
+        .to_owned();
     let text = std::fs::read_to_string(&counts)
         .with_context(|| format!("reading {}", counts.display()))?;
     let profile = parse(&text)?;
@@ -194,7 +243,14 @@ fn callgrind(
         profile.total > 0,
         "callgrind counted nothing inside `{RENDER}`: renamed, or inlined?"
     );
-    Ok((profile, streams))
+    Ok((profile, Rendered { streams, sampler }))
+}
+
+/// The sampler a render's status line names: `rendered WxH at N spp (strategy, sampler) ...`.
+fn rendered_sampler(output: &str) -> Option<&str> {
+    let line = output.lines().find_map(|l| l.strip_prefix("rendered "))?;
+    let (inside, _) = line.split_once('(')?.1.split_once(')')?;
+    Some(inside.split_once(", ")?.1)
 }
 
 /// The total and each function's own instructions in a callgrind output
@@ -349,6 +405,30 @@ fn report(
         }
         writeln!(md)?;
     }
+    writeln!(
+        md,
+        "\nWith each scene's own sampler (its file's, as a user's render runs it), the rest \
+         unchanged:\n"
+    )?;
+    if old.is_some() {
+        writeln!(
+            md,
+            "| scene | sampler | instructions per sample | old | new / old |"
+        )?;
+        writeln!(md, "|---|---|---|---|---|")?;
+    } else {
+        writeln!(md, "| scene | sampler | instructions per sample |")?;
+        writeln!(md, "|---|---|---|")?;
+    }
+    for (scene, new, old) in rows {
+        let (n, sampler) = &new.own_sampler;
+        write!(md, "| {scene} | {sampler} | {n:.0} |")?;
+        if let Some(old) = old {
+            let (o, _) = &old.own_sampler;
+            write!(md, " {o:.0} | {:.3} |", n / o)?;
+        }
+        writeln!(md)?;
+    }
     for (scene, new, _) in rows {
         writeln!(
             md,
@@ -373,6 +453,14 @@ fn report(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_sampler_is_read_from_the_render_line() {
+        let out = "rendered 32x32 at 9 spp (mis, sobol-xor) in 0.10 s, 0.09 M samples/s -> a.exr\n\
+                   samples 9216\n";
+        assert_eq!(rendered_sampler(out), Some("sobol-xor"));
+        assert_eq!(rendered_sampler("samples 9216\n"), None);
+    }
 
     /// A call's inclusive cost belongs to the callee, not to the caller's own
     /// count; compressed names resolve to
