@@ -383,52 +383,35 @@ fn report(
         writeln!(md, "- old: {}", old.description)?;
     }
     writeln!(md)?;
-    if old.is_some() {
-        writeln!(
-            md,
-            "| scene | streams on | instructions per sample | old | new / old |"
-        )?;
-        writeln!(md, "|---|---|---|---|---|")?;
-    } else {
-        writeln!(md, "| scene | streams on | instructions per sample |")?;
-        writeln!(md, "|---|---|---|")?;
-    }
-    for (scene, new, old) in rows {
-        write!(md, "| {scene} | {} | {:.0} |", new.streams, new.per_sample)?;
-        if let Some(old) = old {
-            write!(
-                md,
-                " {:.0} | {:.3} |",
-                old.per_sample,
-                new.per_sample / old.per_sample
-            )?;
-        }
-        writeln!(md)?;
-    }
+    let with_old = old.is_some();
+    count_table(
+        &mut md,
+        "streams on",
+        (rows.iter()).map(|(scene, new, old)| {
+            let old = old.as_ref().map(|o| o.per_sample);
+            (scene.as_str(), new.streams.as_str(), new.per_sample, old)
+        }),
+        with_old,
+    )?;
     writeln!(
         md,
         "\nWith each scene's own sampler (its file's, as a user's render runs it), the rest \
          unchanged:\n"
     )?;
-    if old.is_some() {
-        writeln!(
-            md,
-            "| scene | sampler | instructions per sample | old | new / old |"
-        )?;
-        writeln!(md, "|---|---|---|---|---|")?;
-    } else {
-        writeln!(md, "| scene | sampler | instructions per sample |")?;
-        writeln!(md, "|---|---|---|")?;
-    }
-    for (scene, new, old) in rows {
-        let (n, sampler) = &new.own_sampler;
-        write!(md, "| {scene} | {sampler} | {n:.0} |")?;
-        if let Some(old) = old {
-            let (o, _) = &old.own_sampler;
-            write!(md, " {o:.0} | {:.3} |", n / o)?;
-        }
-        writeln!(md)?;
-    }
+    count_table(
+        &mut md,
+        "sampler",
+        (rows.iter()).map(|(scene, new, old)| {
+            let old = old.as_ref().map(|o| o.own_sampler.0);
+            (
+                scene.as_str(),
+                new.own_sampler.1.as_str(),
+                new.own_sampler.0,
+                old,
+            )
+        }),
+        with_old,
+    )?;
     for (scene, new, _) in rows {
         writeln!(
             md,
@@ -448,6 +431,34 @@ fn report(
         }
     }
     Ok(md)
+}
+
+/// A table of instructions per sample, a row per scene: `(scene, label, count, old count)`,
+/// the label in a column called `column`, and with an old build its count and the ratio.
+fn count_table<'a>(
+    md: &mut String,
+    column: &str,
+    rows: impl Iterator<Item = (&'a str, &'a str, f64, Option<f64>)>,
+    with_old: bool,
+) -> Result<()> {
+    if with_old {
+        writeln!(
+            md,
+            "| scene | {column} | instructions per sample | old | new / old |"
+        )?;
+        writeln!(md, "|---|---|---|---|---|")?;
+    } else {
+        writeln!(md, "| scene | {column} | instructions per sample |")?;
+        writeln!(md, "|---|---|---|")?;
+    }
+    for (scene, label, new, old) in rows {
+        write!(md, "| {scene} | {label} | {new:.0} |")?;
+        if let Some(old) = old {
+            write!(md, " {old:.0} | {:.3} |", new / old)?;
+        }
+        writeln!(md)?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
