@@ -463,18 +463,14 @@ impl Geometry {
     /// `level`'s vectors (a level this CPU lacks runs on the widest it has): the same
     /// outcome and object for each ray on every level and in any company.
     pub fn march(&self, level: SimdLevel, batch: &mut MarchBatch) {
-        let level = if level.is_available() {
-            level
-        } else {
-            SimdLevel::detect()
-        };
-        // The level is available: checked above.
+        let level = level.or_widest();
+        // The level is available: `or_widest` says so.
         let _ = level.dispatch(Clip {
             geometry: self,
             batch,
         });
         let (mut field, rays, params, outcomes) = CandidateLanes::new(self, batch);
-        // The level is available: checked above.
+        // The level is available: `or_widest` says so.
         let _ = sphere_trace_relaxed_stream_of(
             level,
             &mut field,

@@ -12,7 +12,7 @@ use lueur_sdf_math::Ray;
 use lueur_sdf_math::TraceParams;
 
 use crate::strategy::{self, EmissionWeight, Lighting, Scatter, Vertex, VertexSample};
-use crate::surface::{March, SurfaceHit, SurfacePoint};
+use crate::surface::{March, SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::{PathRay, ShadowRay, TraceScratch, Tracing};
 use lueur_scene::RenderSettings;
 
@@ -123,6 +123,10 @@ pub(crate) struct WaveScratch {
     active: Vec<usize>,
     rays: Vec<PathRay>,
     hits: Vec<Option<Hit>>,
+    /// The hits that scatter, with their rays, and their shading points.
+    surface_hits: Vec<(Ray, SurfaceHit)>,
+    surfaces: Vec<SurfacePoint>,
+    surface_scratch: SurfaceScratch,
     shaded: Vec<Shaded>,
     shadow: ShadowQueue,
     free: Vec<bool>,
@@ -138,24 +142,20 @@ struct ShadowQueue {
     lights: Vec<(ShadowRay, Vec3)>,
 }
 
-/// Shades path `index` where it met `on_surface`: the shading point, the shadow rays the vertex
+/// Shades path `index` where it met `on_surface` at `surface`: the shadow rays the vertex
 /// proposes (queued in `shadow`; at a diffuse vertex the delta lights', then next-event
 /// estimation's where the strategy uses it) and the direction it scatters in.
 fn shade(
     estimator: &Estimator<'_>,
     lighting: &Lighting<'_>,
     (index, path): (usize, &Path),
-    on_surface: SurfaceHit,
+    (on_surface, surface): (SurfaceHit, SurfacePoint),
     u: &VertexSample,
     shadow: &mut ShadowQueue,
 ) -> Shaded {
     let Estimator {
-        scene,
-        settings,
-        march,
-        ..
+        scene, settings, ..
     } = *estimator;
-    let surface = SurfacePoint::at_hit(scene, &march, &path.ray, on_surface);
     let material = scene.scene().materials[scene.scene().objects[on_surface.object].material];
     let vertex = Vertex {
         at: surface,
@@ -244,9 +244,29 @@ pub(crate) fn radiance_wave(
         let kind = counters.path_ray(depth);
         scene.intersect_rays(&s.rays, tracing, kind, &mut s.trace, &mut s.hits);
 
+        // The shading points of the hits that scatter, as one stream.
+        s.surface_hits.clear();
+        for (&i, &hit) in s.active.iter().zip(&s.hits) {
+            let path = &s.paths[i];
+            if let Some(on_surface) = SurfaceHit::of(hit)
+                && path.depth < settings.max_depth
+            {
+                s.surface_hits.push((path.ray, on_surface));
+            }
+        }
+        SurfacePoint::at_hits(
+            scene,
+            &march,
+            tracing.simd,
+            &s.surface_hits,
+            &mut s.surface_scratch,
+            &mut s.surfaces,
+        );
+
         s.shaded.clear();
         s.shadow.rays.clear();
         s.shadow.contributions.clear();
+        let mut surfaces = s.surfaces.iter();
         for (&i, &hit) in s.active.iter().zip(&s.hits) {
             let path = &mut s.paths[i];
             let Some(on_surface) = SurfaceHit::of(hit) else {
@@ -257,12 +277,15 @@ pub(crate) fn radiance_wave(
             if path.depth >= settings.max_depth {
                 continue;
             }
+            let surface = *surfaces
+                .next()
+                .expect("a shading point for each hit that scatters");
             let u = VertexSample::draw(&mut samplers[i], ids[i].pixel, ids[i].index, path.depth);
             s.shaded.push(shade(
                 estimator,
                 &lighting,
                 (i, path),
-                on_surface,
+                (on_surface, surface),
                 &u,
                 &mut s.shadow,
             ));

@@ -4,8 +4,9 @@
 
 use glam::Vec3;
 use lueur_sdf_math::{
-    DistanceField, FALLBACK_NORMAL, LaneDistance, PreparedSdf, Ray, TraceParams, gradient_central,
-    gradient_lanes, position_rounding,
+    DistanceField, FALLBACK_NORMAL, Lane, LaneDistance, LaneKernel, LaneVec3, MAX_LANES,
+    PreparedSdf, Ray, SimdLevel, Tetrahedron, TraceParams, gradient_central, gradient_lanes,
+    position_rounding,
 };
 
 use lueur_scene::{Marching, RenderSettings};
@@ -154,6 +155,141 @@ pub(crate) struct SurfacePoint {
     pub inside: bool,
 }
 
+/// The first stage of a shading point ([`SurfacePoint::new`]): the steps the hit's
+/// precision allows, and the point one difference step further along the ray, where the
+/// field's slope along the ray is sampled. The stages are functions of one hit's inputs and
+/// of the field's values they ask for, so a stream of hits ([`SurfacePoint::at_hits`])
+/// evaluates those values in batches and gets the bits of one hit shaded alone.
+#[derive(Clone, Copy, Debug)]
+struct Approach {
+    hit: Vec3,
+    wo: Vec3,
+    precision: HitPrecision,
+    spawn_floor: f32,
+    /// How far the shading point may move from the hit.
+    reach: f32,
+    /// The finite-difference step of the slope and of the normal.
+    h: f32,
+    /// Where the slope along the ray is sampled.
+    ahead: Vec3,
+}
+
+/// Where the normal is taken: the Newton step's point on the ray, or the hit itself.
+#[derive(Clone, Copy, Debug)]
+struct Start {
+    point: Vec3,
+    on_ray: bool,
+}
+
+/// The shading point before its offset: on the ray, or moved along the normal.
+#[derive(Clone, Copy, Debug)]
+struct Projection {
+    p: Vec3,
+    n_geo: Vec3,
+    /// The gradient's length.
+    g: f32,
+    /// Whether `p` moved off the start along the normal (the field is then wanted at `p`).
+    moved: bool,
+}
+
+impl Approach {
+    fn new(hit: Vec3, wo: Vec3, precision: HitPrecision) -> Approach {
+        let spawn_floor = precision.spawn_floor();
+        let epsilon = precision.shell;
+        let reach = 4.0 * epsilon.max(spawn_floor);
+        // The difference step is an eighth of the hit shell: finite
+        // differences blur a crease (the Death Star's rim) over about h,
+        // and at the shell's width (then a quarter pixel for camera rays) that
+        // blur biased whole rows of rim pixels, differently for the
+        // tetrahedron and for central differences (measured: z = 7 between
+        // the two at 32x32, 256 spp). Smooth surfaces do not care: their
+        // gradient is exact at any h. Below, the field's own rounding would
+        // show in the normal.
+        let h = (epsilon * 0.125)
+            .max(GRADIENT_ROUNDINGS * precision.evaluation)
+            .max(2.0 * precision.position);
+        Approach {
+            hit,
+            wo,
+            precision,
+            spawn_floor,
+            reach,
+            h,
+            ahead: hit + -wo * h,
+        }
+    }
+
+    /// Newton along the ray: f(hit + s dir) = 0 with the slope of f along
+    /// the ray by a forward difference (over the offset actually taken,
+    /// which rounding makes differ from h far from the origin), from the field's values
+    /// at the hit and ahead. Taken only where the ray meets the surface at more than
+    /// ~75 degrees from grazing (the slope is at least a quarter of a unit gradient) and
+    /// the step stays within a few shells; elsewhere [`Approach::project`] does the work.
+    fn start(&self, f_hit: f32, f_ahead: f32) -> Start {
+        let (hit, dir) = (self.hit, -self.wo);
+        let slope = (f_ahead - f_hit) / (self.ahead - hit).dot(dir);
+        let along = -f_hit / slope;
+        let on_ray = slope.abs() >= 0.25 && along.is_finite() && along.abs() <= self.reach;
+        Start {
+            point: if on_ray { hit + dir * along } else { hit },
+            on_ray,
+        }
+    }
+
+    /// The normal from the field's gradient at the start and what is left of the way to
+    /// the surface (second order on the ray; the whole shell where the ray grazes), taken
+    /// along the normal: f / |grad f| is the distance to first order, also for bounds
+    /// (L > 1).
+    fn project(&self, start: Start, grad: Vec3, f_start: f32) -> Projection {
+        let g = grad.length();
+        let n_geo = if g.is_finite() && g > 0.0 {
+            grad / g
+        } else {
+            FALLBACK_NORMAL
+        };
+        let step = f_start / g;
+        let moved = !start.on_ray && step.is_finite() && step.abs() <= self.reach;
+        Projection {
+            p: if moved {
+                start.point - n_geo * step
+            } else {
+                start.point
+            },
+            n_geo,
+            g,
+            moved,
+        }
+    }
+
+    /// The shading point, from the field's value `f_p` at the projection's point.
+    fn finish(&self, projection: &Projection, f_p: f32) -> SurfacePoint {
+        let Projection { p, n_geo, g, .. } = *projection;
+        let residual = (f_p / g.max(1e-3)).abs();
+        // A ray marched inside the solid meets it from inside even where it
+        // grazes the wall and the normal's sign is noise.
+        let inside = self.precision.from_inside || n_geo.dot(self.wo) < 0.0;
+        let n = if inside { -n_geo } else { n_geo };
+        // The roundings where the ray will start: at `p`, which the Newton step
+        // may have moved far from where the tracer stopped (along a ray that
+        // meets the surface at 20 degrees, four times the shell).
+        let moved = f32::EPSILON * (p - self.hit).abs().max_element();
+        let spawn_floor = self
+            .spawn_floor
+            .max(SPAWN_ROUNDINGS * position_rounding(p).max(self.precision.evaluation + moved));
+        let offset = spawn_floor.max(if residual.is_finite() {
+            4.0 * residual
+        } else {
+            self.precision.shell
+        });
+        SurfacePoint {
+            p,
+            n,
+            origin: p + n * offset,
+            inside,
+        }
+    }
+}
+
 impl SurfacePoint {
     /// The shading point of a hit on `object` at `t` along `ray` within a shell
     /// `epsilon` thick, on the field that marched it.
@@ -206,80 +342,69 @@ impl SurfacePoint {
         precision: HitPrecision,
         march: &March,
     ) -> SurfacePoint {
-        let spawn_floor = precision.spawn_floor();
-        let epsilon = precision.shell;
-        let reach = 4.0 * epsilon.max(spawn_floor);
-        // The difference step is an eighth of the hit shell: finite
-        // differences blur a crease (the Death Star's rim) over about h,
-        // and at the shell's width (then a quarter pixel for camera rays) that
-        // blur biased whole rows of rim pixels, differently for the
-        // tetrahedron and for central differences (measured: z = 7 between
-        // the two at 32x32, 256 spp). Smooth surfaces do not care: their
-        // gradient is exact at any h. Below, the field's own rounding would
-        // show in the normal.
-        let h = (epsilon * 0.125)
-            .max(GRADIENT_ROUNDINGS * precision.evaluation)
-            .max(2.0 * precision.position);
-        // Newton along the ray: f(hit + s dir) = 0 with the slope of f along
-        // the ray by a forward difference (over the offset actually taken,
-        // which rounding makes differ from h far from the origin). Taken only
-        // where the ray meets the surface at more than ~75 degrees from
-        // grazing (the slope is at least a quarter of a unit gradient) and
-        // the step stays within a few shells; elsewhere the normal projection
-        // below does the work.
-        let dir = -wo;
-        let f_hit = sdf.distance(hit);
-        let ahead = hit + dir * h;
-        let slope = (sdf.distance(ahead) - f_hit) / (ahead - hit).dot(dir);
-        let along = -f_hit / slope;
-        let on_ray = slope.abs() >= 0.25 && along.is_finite() && along.abs() <= reach;
-        let start = if on_ray { hit + dir * along } else { hit };
+        let approach = Approach::new(hit, wo, precision);
+        let start = approach.start(sdf.distance(hit), sdf.distance(approach.ahead));
         let grad = if march.central_normals {
-            gradient_central(sdf, start, h)
+            gradient_central(sdf, start.point, approach.h)
         } else {
-            gradient_lanes(sdf, start, h)
+            gradient_lanes(sdf, start.point, approach.h)
         };
-        let g = grad.length();
-        let n_geo = if g.is_finite() && g > 0.0 {
-            grad / g
+        let f_start = sdf.distance(start.point);
+        let projection = approach.project(start, grad, f_start);
+        let f_p = if projection.moved {
+            sdf.distance(projection.p)
         } else {
-            FALLBACK_NORMAL
+            f_start
         };
-        // What is left (second order on the ray; the whole shell where the
-        // ray grazes) goes along the normal: f / |grad f| is the distance to
-        // first order, also for bounds (L > 1).
-        let f_start = sdf.distance(start);
-        let step = f_start / g;
-        let (p, residual) = if on_ray {
-            (start, (f_start / g.max(1e-3)).abs())
-        } else if step.is_finite() && step.abs() <= reach {
-            let p = start - n_geo * step;
-            (p, (sdf.distance(p) / g.max(1e-3)).abs())
-        } else {
-            (start, (f_start / g.max(1e-3)).abs())
-        };
-        // A ray marched inside the solid meets it from inside even where it
-        // grazes the wall and the normal's sign is noise.
-        let inside = precision.from_inside || n_geo.dot(wo) < 0.0;
-        let n = if inside { -n_geo } else { n_geo };
-        // The roundings where the ray will start: at `p`, which the Newton step
-        // may have moved far from where the tracer stopped (along a ray that
-        // meets the surface at 20 degrees, four times the shell).
-        let moved = f32::EPSILON * (p - hit).abs().max_element();
-        let spawn_floor = spawn_floor
-            .max(SPAWN_ROUNDINGS * position_rounding(p).max(precision.evaluation + moved));
-        let offset = spawn_floor.max(if residual.is_finite() {
-            4.0 * residual
-        } else {
-            epsilon
-        });
-        SurfacePoint {
-            p,
-            n,
-            origin: p + n * offset,
-            inside,
+        approach.finish(&projection, f_p)
+    }
+
+    /// The shading points of `hits` (each with the ray that found it) into `out`
+    /// (cleared first), in order: with fast marching, the field values every hit asks
+    /// for are evaluated object by object, a vector of hits at a time on `level`, with
+    /// the bits of [`SurfacePoint::at_hit`] for each hit alone. Naive marching shades
+    /// one hit at a time, the plain reference.
+    pub fn at_hits(
+        scene: &PreparedScene,
+        march: &March,
+        level: SimdLevel,
+        hits: &[(Ray, SurfaceHit)],
+        scratch: &mut SurfaceScratch,
+        out: &mut Vec<SurfacePoint>,
+    ) {
+        out.clear();
+        if march.marching == Marching::Naive {
+            out.extend(
+                hits.iter()
+                    .map(|(ray, hit)| SurfacePoint::at_hit(scene, march, ray, *hit)),
+            );
+            return;
+        }
+        let level = level.or_widest();
+        out.resize(hits.len(), SurfacePoint::UNSET);
+        scratch.group_by_object(hits, scene.scene().objects.len());
+        for (object, group) in scratch.groups.windows(2).enumerate() {
+            let group = &scratch.order[group[0] as usize..group[1] as usize];
+            if group.is_empty() {
+                continue;
+            }
+            // The level is available: `or_widest` says so.
+            let _ = level.dispatch(HitsOnObject {
+                sdf: scene.prepared(object),
+                hits,
+                group,
+                out,
+            });
         }
     }
+
+    /// A placeholder for a slot that [`SurfacePoint::at_hits`] fills.
+    const UNSET: SurfacePoint = SurfacePoint {
+        p: Vec3::ZERO,
+        n: Vec3::ZERO,
+        origin: Vec3::ZERO,
+        inside: false,
+    };
 
     /// A ray from the surface toward what lies at `distance` along `wi` from
     /// `p`, and the distance to it from the ray's origin.
@@ -292,6 +417,154 @@ impl SurfacePoint {
             }
         }
         (Ray::new(self.origin, wi), distance)
+    }
+}
+
+/// A thread's buffers for [`SurfacePoint::at_hits`], kept from one wave to the next.
+#[derive(Debug, Default)]
+pub(crate) struct SurfaceScratch {
+    /// The hits' indices, grouped by object.
+    order: Vec<u32>,
+    /// Where each object's group starts in `order`, and where the last ends.
+    groups: Vec<u32>,
+}
+
+impl SurfaceScratch {
+    /// Fills `order` and `groups` with the hits grouped by object (a counting sort, which
+    /// keeps each object's hits in their order).
+    fn group_by_object(&mut self, hits: &[(Ray, SurfaceHit)], objects: usize) {
+        let groups = &mut self.groups;
+        groups.clear();
+        groups.resize(objects + 1, 0);
+        for (_, hit) in hits {
+            groups[hit.object + 1] += 1;
+        }
+        for i in 1..groups.len() {
+            groups[i] += groups[i - 1];
+        }
+        self.order.clear();
+        self.order.resize(hits.len(), 0);
+        // `groups[object]` walks through the object's slots, then is put back.
+        for (k, (_, hit)) in hits.iter().enumerate() {
+            let slot = &mut groups[hit.object];
+            self.order[*slot as usize] = k as u32;
+            *slot += 1;
+        }
+        for i in (1..groups.len()).rev() {
+            groups[i] = groups[i - 1];
+        }
+        groups[0] = 0;
+    }
+}
+
+/// The kernel of [`SurfacePoint::at_hits`] for the hits on one object: a vector of hits
+/// at a time, the stages of [`SurfacePoint::new`] run per hit, and the field values each
+/// stage asks for evaluated as vectors (7 per hit, 8 where the point moves along the
+/// normal), on the stack.
+struct HitsOnObject<'a> {
+    sdf: &'a PreparedSdf,
+    hits: &'a [(Ray, SurfaceHit)],
+    /// The indices in `hits` of the hits on this object.
+    group: &'a [u32],
+    out: &'a mut [SurfacePoint],
+}
+
+/// The field at the first [`Lane::LANES`] of `points`, as one vector. `#[inline(always)]`,
+/// not a closure, so that it is compiled for the kernel's instruction set.
+#[inline(always)]
+fn field_at<L: Lane>(sdf: &PreparedSdf, points: &[Vec3; MAX_LANES]) -> [f32; MAX_LANES] {
+    let lanes = L::LANES;
+    let (mut x, mut y, mut z) = ([0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
+    for (i, p) in points.iter().enumerate().take(lanes) {
+        (x[i], y[i], z[i]) = (p.x, p.y, p.z);
+    }
+    let f = sdf.distance_lanes(LaneVec3::new(
+        L::load(&x[..lanes]),
+        L::load(&y[..lanes]),
+        L::load(&z[..lanes]),
+    ));
+    let mut values = [0.0; MAX_LANES];
+    f.store(&mut values[..lanes]);
+    values
+}
+
+impl LaneKernel for HitsOnObject<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let sdf = self.sdf;
+        for chunk in self.group.chunks(L::LANES) {
+            let mut approaches = [None; MAX_LANES];
+            let (mut at, mut ahead) = ([Vec3::ZERO; MAX_LANES], [Vec3::ZERO; MAX_LANES]);
+            for (j, &k) in chunk.iter().enumerate() {
+                let (ray, hit) = &self.hits[k as usize];
+                at[j] = ray.at(hit.t);
+                let precision = HitPrecision::at(sdf, at[j], hit.epsilon, hit.inside);
+                let approach = Approach::new(at[j], -ray.dir, precision);
+                ahead[j] = approach.ahead;
+                approaches[j] = Some(approach);
+            }
+            let (f_at, f_ahead) = (field_at::<L>(sdf, &at), field_at::<L>(sdf, &ahead));
+            let mut starts = [None; MAX_LANES];
+            let mut tetrahedra = [None; MAX_LANES];
+            let mut corners = [[Vec3::ZERO; MAX_LANES]; 4];
+            let mut start_points = [Vec3::ZERO; MAX_LANES];
+            for (j, approach) in approaches.iter().take(chunk.len()).enumerate() {
+                let Some(approach) = approach else { continue };
+                let start = approach.start(f_at[j], f_ahead[j]);
+                let tetrahedron = Tetrahedron::around(start.point, approach.h);
+                for (corner, q) in corners.iter_mut().zip(tetrahedron.points()) {
+                    corner[j] = q;
+                }
+                start_points[j] = start.point;
+                starts[j] = Some(start);
+                tetrahedra[j] = Some(tetrahedron);
+            }
+            let f_corners = [
+                field_at::<L>(sdf, &corners[0]),
+                field_at::<L>(sdf, &corners[1]),
+                field_at::<L>(sdf, &corners[2]),
+                field_at::<L>(sdf, &corners[3]),
+            ];
+            let f_start = field_at::<L>(sdf, &start_points);
+            let mut projections = [None; MAX_LANES];
+            let mut moved = [Vec3::ZERO; MAX_LANES];
+            let mut any_moved = false;
+            for j in 0..chunk.len() {
+                let (Some(approach), Some(start), Some(tetrahedron)) =
+                    (&approaches[j], starts[j], &tetrahedra[j])
+                else {
+                    continue;
+                };
+                let grad = tetrahedron.gradient([
+                    f_corners[0][j],
+                    f_corners[1][j],
+                    f_corners[2][j],
+                    f_corners[3][j],
+                ]);
+                let projection = approach.project(start, grad, f_start[j]);
+                moved[j] = projection.p;
+                any_moved |= projection.moved;
+                projections[j] = Some(projection);
+            }
+            let f_moved = if any_moved {
+                field_at::<L>(sdf, &moved)
+            } else {
+                f_start
+            };
+            for (j, &k) in chunk.iter().enumerate() {
+                let (Some(approach), Some(projection)) = (&approaches[j], &projections[j]) else {
+                    continue;
+                };
+                let f_p = if projection.moved {
+                    f_moved[j]
+                } else {
+                    f_start[j]
+                };
+                self.out[k as usize] = approach.finish(projection, f_p);
+            }
+        }
     }
 }
 
@@ -368,6 +641,106 @@ mod tests {
                         "central {central}, offset {offset}, depth {depth}: normal off by {angle}"
                     );
                     assert!((s.origin - s.p).dot(s.n) > 0.0);
+                }
+            }
+        }
+    }
+
+    /// The stream of shading points gives, on every level this CPU has, the bits of each
+    /// hit shaded alone: hits on five objects (rotated, scaled, a smooth blend) from
+    /// camera rays that cross them head-on, obliquely and grazing, in groups whose sizes
+    /// leave partly filled vectors at every width, from outside and from inside.
+    #[test]
+    fn a_stream_of_hits_gives_each_hit_s_own_shading_point() {
+        use lueur_sdf_math::Quat;
+        let turn = Quat::from_rotation_y(0.7) * Quat::from_rotation_x(0.3);
+        let objects = [
+            Sdf::sphere(0.5).translate(Vec3::new(-1.2, 0.0, 0.0)),
+            Sdf::cuboid(Vec3::new(0.4, 0.3, 0.5))
+                .rotate(turn)
+                .translate(Vec3::new(1.1, 0.2, 0.0)),
+            Sdf::torus(0.5, 0.15)
+                .scale(1.5)
+                .translate(Vec3::new(0.0, 1.2, 0.0)),
+            Sdf::smooth_union(
+                0.2,
+                vec![
+                    Sdf::sphere(0.3).translate(Vec3::new(0.0, -1.0, 0.0)),
+                    Sdf::cuboid(Vec3::splat(0.25)).translate(Vec3::new(0.35, -1.0, 0.0)),
+                ],
+            ),
+            Sdf::cuboid(Vec3::new(8.0, 0.1, 8.0)).translate(Vec3::new(0.0, -2.0, 0.0)),
+        ]
+        .map(|sdf| Object { sdf, material: 0 })
+        .to_vec();
+        let white = Material::Lambertian { albedo: Vec3::ONE };
+        let camera = Camera::new(Vec3::new(0.3, 0.4, 6.0), Vec3::ZERO, Vec3::Y, 50.0).unwrap();
+        let scene: PreparedScene = Scene::new(objects, vec![white], vec![], None, camera)
+            .unwrap()
+            .into();
+        for marching in [Marching::Fast, Marching::Naive] {
+            let settings = RenderSettings {
+                marching,
+                ..RenderSettings::default()
+            };
+            let march = March::new(&scene, &settings);
+            let mut hits = Vec::new();
+            let mut counters = crate::TraceCounters::default();
+            for i in 0..61 {
+                for j in 0..53 {
+                    let (u, v) = (i as f32 / 60.0 * 2.0 - 1.0, j as f32 / 52.0 * 2.0 - 1.0);
+                    let to = Vec3::new(3.0 * u, 3.0 * v, 0.0);
+                    let origin = Vec3::new(0.3, 0.4, 6.0);
+                    let ray = Ray::new(origin, (to - origin).normalize());
+                    let hit = scene.intersect(&ray, &march.camera, marching, &mut counters);
+                    if let Some(hit) = SurfaceHit::of(hit) {
+                        hits.push((ray, hit));
+                        // The same hit as seen from inside, so both sides are shaded.
+                        hits.push((
+                            ray,
+                            SurfaceHit {
+                                inside: true,
+                                ..hit
+                            },
+                        ));
+                    }
+                }
+            }
+            let objects_hit: std::collections::HashSet<usize> =
+                hits.iter().map(|(_, hit)| hit.object).collect();
+            assert_eq!(objects_hit.len(), 5, "every object is hit");
+            let alone: Vec<SurfacePoint> = hits
+                .iter()
+                .map(|(ray, hit)| SurfacePoint::at_hit(&scene, &march, ray, *hit))
+                .collect();
+            let bits = |s: &SurfacePoint| {
+                [s.p, s.n, s.origin]
+                    .map(|v| v.to_array().map(f32::to_bits))
+                    .concat()
+            };
+            for level in SimdLevel::available() {
+                // Whole streams, and streams cut so that groups end part-way through vectors.
+                for len in [hits.len(), 37, 5, 1] {
+                    let mut scratch = SurfaceScratch::default();
+                    let mut streamed = Vec::new();
+                    for (chunk, expected) in hits.chunks(len).zip(alone.chunks(len)) {
+                        SurfacePoint::at_hits(
+                            &scene,
+                            &march,
+                            level,
+                            chunk,
+                            &mut scratch,
+                            &mut streamed,
+                        );
+                        assert_eq!(streamed.len(), chunk.len());
+                        for (k, (a, b)) in streamed.iter().zip(expected).enumerate() {
+                            assert!(
+                                bits(a) == bits(b) && a.inside == b.inside,
+                                "{marching:?}, {level:?}, streams of {len}, hit {k}: \
+                                 {a:?} streamed, {b:?} alone"
+                            );
+                        }
+                    }
                 }
             }
         }

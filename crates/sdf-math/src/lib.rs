@@ -70,7 +70,8 @@ pub use crate::lanes::{
     MaskLane, Neon, Portable, SimdLevel, Sse, Task, UnavailableLevel, Wide,
 };
 pub use crate::normal::{
-    FALLBACK_NORMAL, gradient, gradient_central, gradient_lanes, normal, normal_central,
+    FALLBACK_NORMAL, Tetrahedron, gradient, gradient_central, gradient_lanes, normal,
+    normal_central,
 };
 pub use crate::prepared::PreparedSdf;
 pub use crate::primitives::Primitive;

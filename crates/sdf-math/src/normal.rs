@@ -27,50 +27,68 @@ pub fn normal<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
 ///
 /// Unlike [`normal`] this may be zero or non-finite; callers must check.
 pub fn gradient<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
-    let q = tetrahedron(p, h);
-    gradient_through(q, q.map(|x| field.distance(x)))
+    let q = Tetrahedron::around(p, h);
+    q.gradient(q.points().map(|x| field.distance(x)))
 }
 
 /// [`gradient`] with the four evaluations made as one vector of four lanes: the same
 /// bits, since each lane gives the scalar value.
 pub fn gradient_lanes<F: LaneDistance + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
-    let q = tetrahedron(p, h);
-    let lanes = |c: fn(Vec3) -> f32| Wide::<4, Portable>::from_array(q.map(c));
+    let q = Tetrahedron::around(p, h);
+    let lanes = |c: fn(Vec3) -> f32| Wide::<4, Portable>::from_array(q.points().map(c));
     let f = field.distance_lanes(LaneVec3::new(
         lanes(|v| v.x),
         lanes(|v| v.y),
         lanes(|v| v.z),
     ));
-    gradient_through(q, f.to_array())
+    q.gradient(f.to_array())
 }
 
-/// The points [`gradient`] samples around `p`, at the step `h` made usable there.
-#[inline]
-fn tetrahedron(p: Vec3, h: f32) -> [Vec3; 4] {
-    // iq, "normalsSDF": the vertices of a tetrahedron around p, one evaluation fewer than
-    // central differences.
-    const K: [Vec3; 4] = [
-        Vec3::new(1.0, -1.0, -1.0),
-        Vec3::new(-1.0, -1.0, 1.0),
-        Vec3::new(-1.0, 1.0, -1.0),
-        Vec3::new(1.0, 1.0, 1.0),
-    ];
-    let h = usable_step(p, h);
-    K.map(|k| p + k * h)
-}
+/// The four points [`gradient`] samples around a point, and the gradient of the linear
+/// function through the field's values there. A caller that evaluates many fields' points
+/// in batches (a stream of hits) takes the points, evaluates them as it likes, and gets
+/// the same bits as [`gradient`] for the same values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tetrahedron([Vec3; 4]);
 
-/// The gradient of the linear function through the field's values `f` at the points `q`.
-#[inline]
-fn gradient_through(q: [Vec3; 4], f: [f32; 4]) -> Vec3 {
-    // The points actually sampled are p + h k rounded to f32, which far from the origin
-    // differ from p + h k by up to half an ulp of p: as much as 6% of h at the smallest
-    // step. Their differences are exact (they are close to each other), so the gradient
-    // of the linear function through the four samples, solved with the real offsets,
-    // carries only the field's own rounding. With exact offsets it is iq's
-    // sum_i k_i f(p + h k_i) / (4 h).
-    let offsets = Mat3::from_cols(q[0] - q[3], q[1] - q[3], q[2] - q[3]).transpose();
-    let rises = Vec3::new(f[0] - f[3], f[1] - f[3], f[2] - f[3]);
-    offsets.inverse() * rises
+impl Tetrahedron {
+    /// The tetrahedron around `p` at the step `h`, made usable there (see [`normal`]).
+    #[inline]
+    pub fn around(p: Vec3, h: f32) -> Tetrahedron {
+        // iq, "normalsSDF": the vertices of a tetrahedron around p, one evaluation fewer
+        // than central differences.
+        const K: [Vec3; 4] = [
+            Vec3::new(1.0, -1.0, -1.0),
+            Vec3::new(-1.0, -1.0, 1.0),
+            Vec3::new(-1.0, 1.0, -1.0),
+            Vec3::new(1.0, 1.0, 1.0),
+        ];
+        let h = usable_step(p, h);
+        Tetrahedron(K.map(|k| p + k * h))
+    }
+
+    /// The points to evaluate the field at, in the order [`Tetrahedron::gradient`] takes
+    /// their values.
+    #[inline]
+    pub fn points(&self) -> [Vec3; 4] {
+        self.0
+    }
+
+    /// The gradient of the linear function through the field's values `f` at the points.
+    /// Not normalised, and it may be zero or non-finite (see [`gradient`]).
+    #[inline]
+    pub fn gradient(&self, f: [f32; 4]) -> Vec3 {
+        let q = self.0;
+        // The points actually sampled are p + h k rounded to f32, which far from the
+        // origin differ from p + h k by up to half an ulp of p: as much as 6% of h at the
+        // smallest step. Their differences are exact (they are close to each other), so
+        // the gradient of the linear function through the four samples, solved with the
+        // real offsets, carries only the field's own rounding. With exact offsets it is
+        // iq's sum_i k_i f(p + h k_i) / (4 h).
+        let offsets = Mat3::from_cols(q[0] - q[3], q[1] - q[3], q[2] - q[3]).transpose();
+        let rises = Vec3::new(f[0] - f[3], f[1] - f[3], f[2] - f[3]);
+        offsets.inverse() * rises
+    }
 }
 
 /// The gradient by central differences (6 evaluations), not normalised: the naive

@@ -66,6 +66,16 @@ impl SimdLevel {
             .unwrap_or(SimdLevel::Portable)
     }
 
+    /// This level where the CPU has it, else the widest it has ([`SimdLevel::detect`]):
+    /// what a stream asked to run on a level runs on.
+    pub fn or_widest(self) -> SimdLevel {
+        if self.is_available() {
+            self
+        } else {
+            SimdLevel::detect()
+        }
+    }
+
     /// Every level this CPU can run, narrowest first (always `Scalar` and `Portable`).
     pub fn available() -> Vec<SimdLevel> {
         Self::ALL.into_iter().filter(|l| l.is_available()).collect()
