@@ -6,7 +6,7 @@ use glam::Vec3;
 use lueur_sdf_math::{
     DistanceField, FALLBACK_NORMAL, Lane, LaneDistance, LaneKernel, LaneVec3, MAX_LANES,
     PreparedSdf, Ray, SimdLevel, Tetrahedron, TraceParams, gradient_central, gradient_lanes,
-    position_rounding,
+    position_rounding_lanes,
 };
 
 use lueur_scene::{Marching, RenderSettings};
@@ -101,35 +101,50 @@ const SPAWN_ROUNDINGS: f32 = 16.0;
 /// estimators themselves, which use the real offsets of their samples).
 const GRADIENT_ROUNDINGS: f32 = 1024.0;
 
-/// What limits the precision of one hit: the tracer's shell there and f32 rounding.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct HitPrecision {
+/// What limits the precision of a hit (one per lane: `L` is `f32` or a vector): the
+/// tracer's shell there and f32 rounding.
+#[derive(Clone, Copy)]
+pub(crate) struct HitPrecision<L: Lane = f32> {
     /// The hit threshold in force where the tracer stopped: it stopped somewhere in a
     /// shell this thick.
-    pub shell: f32,
+    pub shell: L,
     /// The rounding of the hit point's position.
-    pub position: f32,
+    pub position: L,
     /// The rounding of the hit object's field at the hit point.
-    pub evaluation: f32,
+    pub evaluation: L,
     /// Whether the ray reached the surface from inside the solid (it was
     /// marched by the negated field).
-    pub from_inside: bool,
+    pub from_inside: L::Mask,
 }
 
 impl HitPrecision {
     /// The precision of a hit on `object` at `hit` within a shell `shell` thick.
     pub fn at(object: &PreparedSdf, hit: Vec3, shell: f32, from_inside: bool) -> HitPrecision {
+        HitPrecision::at_lanes(object, LaneVec3::from(hit), shell, from_inside)
+    }
+}
+
+impl<L: Lane> HitPrecision<L> {
+    /// [`HitPrecision::at`] for each lane's hit.
+    #[inline(always)]
+    fn at_lanes(
+        object: &PreparedSdf,
+        hit: LaneVec3<L>,
+        shell: L,
+        from_inside: L::Mask,
+    ) -> HitPrecision<L> {
         HitPrecision {
             shell,
-            position: position_rounding(hit),
-            evaluation: f32::EPSILON * object.evaluation_scale(hit),
+            position: position_rounding_lanes(hit),
+            evaluation: L::splat(f32::EPSILON) * object.evaluation_scale_lanes(hit),
             from_inside,
         }
     }
 
     /// The smallest offset of a ray's origin above the surface.
-    fn spawn_floor(&self) -> f32 {
-        SPAWN_ROUNDINGS * self.position.max(self.evaluation)
+    #[inline(always)]
+    fn spawn_floor(&self) -> L {
+        L::splat(SPAWN_ROUNDINGS) * self.position.max(self.evaluation)
     }
 }
 
@@ -155,48 +170,74 @@ pub(crate) struct SurfacePoint {
     pub inside: bool,
 }
 
-/// The first stage of a shading point ([`SurfacePoint::new`]): the steps the hit's
-/// precision allows, and the point one difference step further along the ray, where the
-/// field's slope along the ray is sampled. The stages are functions of one hit's inputs and
-/// of the field's values they ask for, so a stream of hits ([`SurfacePoint::at_hits`])
-/// evaluates those values in batches and gets the bits of one hit shaded alone.
-#[derive(Clone, Copy, Debug)]
-struct Approach {
-    hit: Vec3,
-    wo: Vec3,
-    precision: HitPrecision,
-    spawn_floor: f32,
+/// The first stage of a shading point ([`SurfacePoint::new`]), one hit per lane: the steps
+/// the hit's precision allows, and the point one difference step further along the ray,
+/// where the field's slope along the ray is sampled. The stages are functions of each
+/// lane's hit and of the field values they ask for, written once over [`Lane`]: one hit
+/// shaded alone runs them on `f32`, a stream of hits ([`SurfacePoint::at_hits`]) on
+/// vectors, with the same bits.
+#[derive(Clone, Copy)]
+struct Approach<L: Lane = f32> {
+    hit: LaneVec3<L>,
+    wo: LaneVec3<L>,
+    precision: HitPrecision<L>,
+    spawn_floor: L,
     /// How far the shading point may move from the hit.
-    reach: f32,
+    reach: L,
     /// The finite-difference step of the slope and of the normal.
-    h: f32,
+    h: L,
     /// Where the slope along the ray is sampled.
-    ahead: Vec3,
+    ahead: LaneVec3<L>,
 }
 
 /// Where the normal is taken: the Newton step's point on the ray, or the hit itself.
-#[derive(Clone, Copy, Debug)]
-struct Start {
-    point: Vec3,
-    on_ray: bool,
+#[derive(Clone, Copy)]
+struct Start<L: Lane = f32> {
+    point: LaneVec3<L>,
+    on_ray: L::Mask,
 }
 
 /// The shading point before its offset: on the ray, or moved along the normal.
-#[derive(Clone, Copy, Debug)]
-struct Projection {
-    p: Vec3,
-    n_geo: Vec3,
+#[derive(Clone, Copy)]
+struct Projection<L: Lane = f32> {
+    p: LaneVec3<L>,
+    n_geo: LaneVec3<L>,
     /// The gradient's length.
-    g: f32,
+    g: L,
     /// Whether `p` moved off the start along the normal (the field is then wanted at `p`).
-    moved: bool,
+    moved: L::Mask,
 }
 
-impl Approach {
-    fn new(hit: Vec3, wo: Vec3, precision: HitPrecision) -> Approach {
+/// A shading point per lane, as [`Approach::finish`] makes it.
+struct SurfaceLanes<L: Lane> {
+    p: LaneVec3<L>,
+    n: LaneVec3<L>,
+    origin: LaneVec3<L>,
+    inside: L::Mask,
+}
+
+/// [`f32::is_finite`] per lane: `|x| < inf`.
+#[inline(always)]
+fn is_finite<L: Lane>(x: L) -> L::Mask {
+    x.abs().lt(L::splat(f32::INFINITY))
+}
+
+/// `if mask { a } else { b }` per lane.
+#[inline(always)]
+fn select<L: Lane>(mask: L::Mask, a: LaneVec3<L>, b: LaneVec3<L>) -> LaneVec3<L> {
+    LaneVec3::new(
+        L::select(mask, a.x, b.x),
+        L::select(mask, a.y, b.y),
+        L::select(mask, a.z, b.z),
+    )
+}
+
+impl<L: Lane> Approach<L> {
+    #[inline(always)]
+    fn new(hit: LaneVec3<L>, wo: LaneVec3<L>, precision: HitPrecision<L>) -> Approach<L> {
         let spawn_floor = precision.spawn_floor();
         let epsilon = precision.shell;
-        let reach = 4.0 * epsilon.max(spawn_floor);
+        let reach = L::splat(4.0) * epsilon.max(spawn_floor);
         // The difference step is an eighth of the hit shell: finite
         // differences blur a crease (the Death Star's rim) over about h,
         // and at the shell's width (then a quarter pixel for camera rays) that
@@ -205,9 +246,9 @@ impl Approach {
         // the two at 32x32, 256 spp). Smooth surfaces do not care: their
         // gradient is exact at any h. Below, the field's own rounding would
         // show in the normal.
-        let h = (epsilon * 0.125)
-            .max(GRADIENT_ROUNDINGS * precision.evaluation)
-            .max(2.0 * precision.position);
+        let h = (epsilon * L::splat(0.125))
+            .max(L::splat(GRADIENT_ROUNDINGS) * precision.evaluation)
+            .max(L::splat(2.0) * precision.position);
         Approach {
             hit,
             wo,
@@ -225,13 +266,17 @@ impl Approach {
     /// at the hit and ahead. Taken only where the ray meets the surface at more than
     /// ~75 degrees from grazing (the slope is at least a quarter of a unit gradient) and
     /// the step stays within a few shells; elsewhere [`Approach::project`] does the work.
-    fn start(&self, f_hit: f32, f_ahead: f32) -> Start {
+    #[inline(always)]
+    fn start(&self, f_hit: L, f_ahead: L) -> Start<L> {
         let (hit, dir) = (self.hit, -self.wo);
         let slope = (f_ahead - f_hit) / (self.ahead - hit).dot(dir);
         let along = -f_hit / slope;
-        let on_ray = slope.abs() >= 0.25 && along.is_finite() && along.abs() <= self.reach;
+        let on_ray = L::and(
+            slope.abs().ge(L::splat(0.25)),
+            L::and(is_finite(along), self.reach.ge(along.abs())),
+        );
         Start {
-            point: if on_ray { hit + dir * along } else { hit },
+            point: select(on_ray, hit + dir * along, hit),
             on_ray,
         }
     }
@@ -240,21 +285,21 @@ impl Approach {
     /// the surface (second order on the ray; the whole shell where the ray grazes), taken
     /// along the normal: f / |grad f| is the distance to first order, also for bounds
     /// (L > 1).
-    fn project(&self, start: Start, grad: Vec3, f_start: f32) -> Projection {
+    #[inline(always)]
+    fn project(&self, start: Start<L>, grad: LaneVec3<L>, f_start: L) -> Projection<L> {
         let g = grad.length();
-        let n_geo = if g.is_finite() && g > 0.0 {
-            grad / g
-        } else {
-            FALLBACK_NORMAL
-        };
+        let n_geo = select(
+            L::and(is_finite(g), g.gt(L::splat(0.0))),
+            grad / g,
+            LaneVec3::splat(FALLBACK_NORMAL),
+        );
         let step = f_start / g;
-        let moved = !start.on_ray && step.is_finite() && step.abs() <= self.reach;
+        let moved = L::and(
+            L::not(start.on_ray),
+            L::and(is_finite(step), self.reach.ge(step.abs())),
+        );
         Projection {
-            p: if moved {
-                start.point - n_geo * step
-            } else {
-                start.point
-            },
+            p: select(moved, start.point - n_geo * step, start.point),
             n_geo,
             g,
             moved,
@@ -262,26 +307,31 @@ impl Approach {
     }
 
     /// The shading point, from the field's value `f_p` at the projection's point.
-    fn finish(&self, projection: &Projection, f_p: f32) -> SurfacePoint {
+    #[inline(always)]
+    fn finish(&self, projection: &Projection<L>, f_p: L) -> SurfaceLanes<L> {
         let Projection { p, n_geo, g, .. } = *projection;
-        let residual = (f_p / g.max(1e-3)).abs();
+        let residual = (f_p / g.max(L::splat(1e-3))).abs();
         // A ray marched inside the solid meets it from inside even where it
         // grazes the wall and the normal's sign is noise.
-        let inside = self.precision.from_inside || n_geo.dot(self.wo) < 0.0;
-        let n = if inside { -n_geo } else { n_geo };
+        let inside = L::or(
+            self.precision.from_inside,
+            n_geo.dot(self.wo).lt(L::splat(0.0)),
+        );
+        let n = select(inside, -n_geo, n_geo);
         // The roundings where the ray will start: at `p`, which the Newton step
         // may have moved far from where the tracer stopped (along a ray that
         // meets the surface at 20 degrees, four times the shell).
-        let moved = f32::EPSILON * (p - self.hit).abs().max_element();
-        let spawn_floor = self
-            .spawn_floor
-            .max(SPAWN_ROUNDINGS * position_rounding(p).max(self.precision.evaluation + moved));
-        let offset = spawn_floor.max(if residual.is_finite() {
-            4.0 * residual
-        } else {
-            self.precision.shell
-        });
-        SurfacePoint {
+        let moved = L::splat(f32::EPSILON) * (p - self.hit).abs().max_element();
+        let spawn_floor = self.spawn_floor.max(
+            L::splat(SPAWN_ROUNDINGS)
+                * position_rounding_lanes(p).max(self.precision.evaluation + moved),
+        );
+        let offset = spawn_floor.max(L::select(
+            is_finite(residual),
+            L::splat(4.0) * residual,
+            self.precision.shell,
+        ));
+        SurfaceLanes {
             p,
             n,
             origin: p + n * offset,
@@ -342,28 +392,34 @@ impl SurfacePoint {
         precision: HitPrecision,
         march: &March,
     ) -> SurfacePoint {
-        let approach = Approach::new(hit, wo, precision);
-        let start = approach.start(sdf.distance(hit), sdf.distance(approach.ahead));
+        let approach = Approach::new(LaneVec3::from(hit), LaneVec3::from(wo), precision);
+        let start = approach.start(sdf.distance(hit), sdf.distance(approach.ahead.into()));
+        let at = Vec3::from(start.point);
         let grad = if march.central_normals {
-            gradient_central(sdf, start.point, approach.h)
+            gradient_central(sdf, at, approach.h)
         } else {
-            gradient_lanes(sdf, start.point, approach.h)
+            gradient_lanes(sdf, at, approach.h)
         };
-        let f_start = sdf.distance(start.point);
-        let projection = approach.project(start, grad, f_start);
+        let f_start = sdf.distance(at);
+        let projection = approach.project(start, grad.into(), f_start);
         let f_p = if projection.moved {
-            sdf.distance(projection.p)
+            sdf.distance(projection.p.into())
         } else {
             f_start
         };
-        approach.finish(&projection, f_p)
+        let s = approach.finish(&projection, f_p);
+        SurfacePoint {
+            p: s.p.into(),
+            n: s.n.into(),
+            origin: s.origin.into(),
+            inside: s.inside,
+        }
     }
 
     /// The shading points of `hits` (each with the ray that found it) into `out`
-    /// (cleared first), in order: with fast marching, the field values every hit asks
-    /// for are evaluated object by object, a vector of hits at a time on `level`, with
-    /// the bits of [`SurfacePoint::at_hit`] for each hit alone. Naive marching shades
-    /// one hit at a time, the plain reference.
+    /// (cleared first), in order: with fast marching, object by object, a vector of hits
+    /// at a time on `level`, with the bits of [`SurfacePoint::at_hit`] for each hit
+    /// alone. Naive marching shades one hit at a time, the plain reference.
     pub fn at_hits(
         scene: &PreparedScene,
         march: &March,
@@ -457,10 +513,10 @@ impl SurfaceScratch {
     }
 }
 
-/// The kernel of [`SurfacePoint::at_hits`] for the hits on one object: a vector of hits
-/// at a time, the stages of [`SurfacePoint::new`] run per hit, and the field values each
-/// stage asks for evaluated as vectors (7 per hit, 8 where the point moves along the
-/// normal), on the stack.
+/// The kernel of [`SurfacePoint::at_hits`] for the hits on one object: the stages of
+/// [`SurfacePoint::new`] on a vector of hits at a time, a hit per lane, with the field
+/// values they ask for evaluated as vectors (7, and an 8th where some lane's point
+/// moves along the normal).
 struct HitsOnObject<'a> {
     sdf: &'a PreparedSdf,
     hits: &'a [(Ray, SurfaceHit)],
@@ -469,100 +525,83 @@ struct HitsOnObject<'a> {
     out: &'a mut [SurfacePoint],
 }
 
-/// The field at the first [`Lane::LANES`] of `points`, as one vector. `#[inline(always)]`,
-/// not a closure, so that it is compiled for the kernel's instruction set.
-#[inline(always)]
-fn field_at<L: Lane>(sdf: &PreparedSdf, points: &[Vec3; MAX_LANES]) -> [f32; MAX_LANES] {
-    let lanes = L::LANES;
-    let (mut x, mut y, mut z) = ([0.0; MAX_LANES], [0.0; MAX_LANES], [0.0; MAX_LANES]);
-    for (i, p) in points.iter().enumerate().take(lanes) {
-        (x[i], y[i], z[i]) = (p.x, p.y, p.z);
-    }
-    let f = sdf.distance_lanes(LaneVec3::new(
-        L::load(&x[..lanes]),
-        L::load(&y[..lanes]),
-        L::load(&z[..lanes]),
-    ));
-    let mut values = [0.0; MAX_LANES];
-    f.store(&mut values[..lanes]);
-    values
-}
-
 impl LaneKernel for HitsOnObject<'_> {
     type Output = ();
 
     #[inline(always)]
     fn run<L: Lane>(self) {
         let sdf = self.sdf;
-        for chunk in self.group.chunks(L::LANES) {
-            let mut approaches = [None; MAX_LANES];
-            let (mut at, mut ahead) = ([Vec3::ZERO; MAX_LANES], [Vec3::ZERO; MAX_LANES]);
-            for (j, &k) in chunk.iter().enumerate() {
+        let lanes = L::LANES;
+        for chunk in self.group.chunks(lanes) {
+            // Each lane's hit; lanes past the chunk repeat its first hit, so that every
+            // lane computes something finite.
+            let mut rows = [[0.0; MAX_LANES]; 8];
+            for j in 0..lanes {
+                let k = if j < chunk.len() { chunk[j] } else { chunk[0] };
                 let (ray, hit) = &self.hits[k as usize];
-                at[j] = ray.at(hit.t);
-                let precision = HitPrecision::at(sdf, at[j], hit.epsilon, hit.inside);
-                let approach = Approach::new(at[j], -ray.dir, precision);
-                ahead[j] = approach.ahead;
-                approaches[j] = Some(approach);
-            }
-            let (f_at, f_ahead) = (field_at::<L>(sdf, &at), field_at::<L>(sdf, &ahead));
-            let mut starts = [None; MAX_LANES];
-            let mut tetrahedra = [None; MAX_LANES];
-            let mut corners = [[Vec3::ZERO; MAX_LANES]; 4];
-            let mut start_points = [Vec3::ZERO; MAX_LANES];
-            for (j, approach) in approaches.iter().take(chunk.len()).enumerate() {
-                let Some(approach) = approach else { continue };
-                let start = approach.start(f_at[j], f_ahead[j]);
-                let tetrahedron = Tetrahedron::around(start.point, approach.h);
-                for (corner, q) in corners.iter_mut().zip(tetrahedron.points()) {
-                    corner[j] = q;
+                let at = ray.at(hit.t);
+                let row = [
+                    at.x,
+                    at.y,
+                    at.z,
+                    -ray.dir.x,
+                    -ray.dir.y,
+                    -ray.dir.z,
+                    hit.epsilon,
+                    if hit.inside { 1.0 } else { 0.0 },
+                ];
+                for (r, value) in rows.iter_mut().zip(row) {
+                    r[j] = value;
                 }
-                start_points[j] = start.point;
-                starts[j] = Some(start);
-                tetrahedra[j] = Some(tetrahedron);
             }
-            let f_corners = [
-                field_at::<L>(sdf, &corners[0]),
-                field_at::<L>(sdf, &corners[1]),
-                field_at::<L>(sdf, &corners[2]),
-                field_at::<L>(sdf, &corners[3]),
-            ];
-            let f_start = field_at::<L>(sdf, &start_points);
-            let mut projections = [None; MAX_LANES];
-            let mut moved = [Vec3::ZERO; MAX_LANES];
-            let mut any_moved = false;
-            for j in 0..chunk.len() {
-                let (Some(approach), Some(start), Some(tetrahedron)) =
-                    (&approaches[j], starts[j], &tetrahedra[j])
-                else {
-                    continue;
-                };
-                let grad = tetrahedron.gradient([
-                    f_corners[0][j],
-                    f_corners[1][j],
-                    f_corners[2][j],
-                    f_corners[3][j],
-                ]);
-                let projection = approach.project(start, grad, f_start[j]);
-                moved[j] = projection.p;
-                any_moved |= projection.moved;
-                projections[j] = Some(projection);
-            }
-            let f_moved = if any_moved {
-                field_at::<L>(sdf, &moved)
+            // Not a closure: it would be compiled apart from the kernel's features.
+            let [x, y, z, wx, wy, wz, epsilon, inside] = &rows;
+            let hit = LaneVec3::new(
+                L::load(&x[..lanes]),
+                L::load(&y[..lanes]),
+                L::load(&z[..lanes]),
+            );
+            let wo = LaneVec3::new(
+                L::load(&wx[..lanes]),
+                L::load(&wy[..lanes]),
+                L::load(&wz[..lanes]),
+            );
+            let from_inside = L::load(&inside[..lanes]).gt(L::splat(0.5));
+            let precision =
+                HitPrecision::at_lanes(sdf, hit, L::load(&epsilon[..lanes]), from_inside);
+            let approach = Approach::new(hit, wo, precision);
+            let start = approach.start(sdf.distance_lanes(hit), sdf.distance_lanes(approach.ahead));
+            let tetrahedron = Tetrahedron::around(start.point, approach.h);
+            let q = tetrahedron.points();
+            let grad = tetrahedron.gradient([
+                sdf.distance_lanes(q[0]),
+                sdf.distance_lanes(q[1]),
+                sdf.distance_lanes(q[2]),
+                sdf.distance_lanes(q[3]),
+            ]);
+            let f_start = sdf.distance_lanes(start.point);
+            let projection = approach.project(start, grad, f_start);
+            let f_p = if L::any(projection.moved) {
+                L::select(projection.moved, sdf.distance_lanes(projection.p), f_start)
             } else {
                 f_start
             };
+            let s = approach.finish(&projection, f_p);
+            let mut out = [[0.0; MAX_LANES]; 9];
+            for (o, v) in out.iter_mut().zip([
+                s.p.x, s.p.y, s.p.z, s.n.x, s.n.y, s.n.z, s.origin.x, s.origin.y, s.origin.z,
+            ]) {
+                v.store(&mut o[..lanes]);
+            }
+            let inside = L::bits(s.inside);
             for (j, &k) in chunk.iter().enumerate() {
-                let (Some(approach), Some(projection)) = (&approaches[j], &projections[j]) else {
-                    continue;
+                let v = |r: usize| Vec3::new(out[r][j], out[r + 1][j], out[r + 2][j]);
+                self.out[k as usize] = SurfacePoint {
+                    p: v(0),
+                    n: v(3),
+                    origin: v(6),
+                    inside: inside >> j & 1 != 0,
                 };
-                let f_p = if projection.moved {
-                    f_moved[j]
-                } else {
-                    f_start[j]
-                };
-                self.out[k as usize] = approach.finish(projection, f_p);
             }
         }
     }
@@ -573,7 +612,7 @@ mod tests {
     use super::*;
     use lueur_materials::Material;
     use lueur_scene::{Camera, Light, Object, Scene};
-    use lueur_sdf_math::Sdf;
+    use lueur_sdf_math::{Sdf, position_rounding};
 
     /// A march with the default thresholds.
     fn march(central_normals: bool) -> March {

@@ -82,6 +82,6 @@ pub use crate::stream::{
     sphere_trace_relaxed_stream_of, sphere_trace_stream, sphere_trace_stream_at, write_lane,
 };
 pub use crate::trace::{
-    HIT_ULPS, OVER_RELAXATION, TraceOutcome, TraceParams, position_rounding, sphere_trace,
-    sphere_trace_relaxed,
+    HIT_ULPS, OVER_RELAXATION, TraceOutcome, TraceParams, position_rounding,
+    position_rounding_lanes, sphere_trace, sphere_trace_relaxed,
 };

@@ -1,9 +1,9 @@
 //! Surface normals as normalised finite-difference gradients of a distance field.
 
-use glam::{Mat3, Vec3};
+use glam::Vec3;
 
 use crate::DistanceField;
-use crate::lanes::{LaneDistance, LaneVec3, Portable, Wide};
+use crate::lanes::{Lane, LaneDistance, LaneVec3, Portable, Wide};
 
 /// The direction returned where the gradient estimate vanishes or is not finite (the centre
 /// of a sphere, the axis of a torus, a NaN field). Any fixed unit vector would do; what
@@ -27,34 +27,34 @@ pub fn normal<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
 ///
 /// Unlike [`normal`] this may be zero or non-finite; callers must check.
 pub fn gradient<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
-    let q = Tetrahedron::around(p, h);
-    q.gradient(q.points().map(|x| field.distance(x)))
+    let q = Tetrahedron::around(LaneVec3::from(p), h);
+    Vec3::from(q.gradient(q.points().map(|x| field.distance(Vec3::from(x)))))
 }
 
 /// [`gradient`] with the four evaluations made as one vector of four lanes: the same
 /// bits, since each lane gives the scalar value.
 pub fn gradient_lanes<F: LaneDistance + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
-    let q = Tetrahedron::around(p, h);
-    let lanes = |c: fn(Vec3) -> f32| Wide::<4, Portable>::from_array(q.points().map(c));
+    let q = Tetrahedron::around(LaneVec3::from(p), h);
+    let lanes = |c: fn(LaneVec3<f32>) -> f32| Wide::<4, Portable>::from_array(q.points().map(c));
     let f = field.distance_lanes(LaneVec3::new(
         lanes(|v| v.x),
         lanes(|v| v.y),
         lanes(|v| v.z),
     ));
-    q.gradient(f.to_array())
+    Vec3::from(q.gradient(f.to_array()))
 }
 
-/// The four points [`gradient`] samples around a point, and the gradient of the linear
-/// function through the field's values there. A caller that evaluates many fields' points
-/// in batches (a stream of hits) takes the points, evaluates them as it likes, and gets
-/// the same bits as [`gradient`] for the same values.
+/// The four points [`gradient`] samples around a point (one per lane: `L` is `f32` or a
+/// vector), and the gradient of the linear function through the field's values there. A
+/// caller that evaluates many points in batches (a stream of hits) takes the points,
+/// evaluates them as it likes, and gets the bits of [`gradient`] for the same values.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Tetrahedron([Vec3; 4]);
+pub struct Tetrahedron<L = f32>([LaneVec3<L>; 4]);
 
-impl Tetrahedron {
+impl<L: Lane> Tetrahedron<L> {
     /// The tetrahedron around `p` at the step `h`, made usable there (see [`normal`]).
-    #[inline]
-    pub fn around(p: Vec3, h: f32) -> Tetrahedron {
+    #[inline(always)]
+    pub fn around(p: LaneVec3<L>, h: L) -> Tetrahedron<L> {
         // iq, "normalsSDF": the vertices of a tetrahedron around p, one evaluation fewer
         // than central differences.
         const K: [Vec3; 4] = [
@@ -64,20 +64,27 @@ impl Tetrahedron {
             Vec3::new(1.0, 1.0, 1.0),
         ];
         let h = usable_step(p, h);
-        Tetrahedron(K.map(|k| p + k * h))
+        // Not `K.map`: a closure would be compiled apart from a vector kernel's features.
+        Tetrahedron([
+            p + LaneVec3::splat(K[0]) * h,
+            p + LaneVec3::splat(K[1]) * h,
+            p + LaneVec3::splat(K[2]) * h,
+            p + LaneVec3::splat(K[3]) * h,
+        ])
     }
 
     /// The points to evaluate the field at, in the order [`Tetrahedron::gradient`] takes
     /// their values.
-    #[inline]
-    pub fn points(&self) -> [Vec3; 4] {
+    #[inline(always)]
+    pub fn points(&self) -> [LaneVec3<L>; 4] {
         self.0
     }
 
-    /// The gradient of the linear function through the field's values `f` at the points.
+    /// The gradient of the linear function through the field's values `f` at the points:
+    /// glam's `Mat3::inverse` of the offsets times the rises, written out in its order.
     /// Not normalised, and it may be zero or non-finite (see [`gradient`]).
-    #[inline]
-    pub fn gradient(&self, f: [f32; 4]) -> Vec3 {
+    #[inline(always)]
+    pub fn gradient(&self, f: [L; 4]) -> LaneVec3<L> {
         let q = self.0;
         // The points actually sampled are p + h k rounded to f32, which far from the
         // origin differ from p + h k by up to half an ulp of p: as much as 6% of h at the
@@ -85,16 +92,27 @@ impl Tetrahedron {
         // the gradient of the linear function through the four samples, solved with the
         // real offsets, carries only the field's own rounding. With exact offsets it is
         // iq's sum_i k_i f(p + h k_i) / (4 h).
-        let offsets = Mat3::from_cols(q[0] - q[3], q[1] - q[3], q[2] - q[3]).transpose();
-        let rises = Vec3::new(f[0] - f[3], f[1] - f[3], f[2] - f[3]);
-        offsets.inverse() * rises
+        let (a, b, c) = (q[0] - q[3], q[1] - q[3], q[2] - q[3]);
+        // The offsets as the rows of a matrix; its columns:
+        let x = LaneVec3::new(a.x, b.x, c.x);
+        let y = LaneVec3::new(a.y, b.y, c.y);
+        let z = LaneVec3::new(a.z, b.z, c.z);
+        let rises = LaneVec3::new(f[0] - f[3], f[1] - f[3], f[2] - f[3]);
+        let (t0, t1, t2) = (y.cross(z), z.cross(x), x.cross(y));
+        let inv_det = L::splat(1.0) / x.dot(t0);
+        let (t0, t1, t2) = (t0 * inv_det, t1 * inv_det, t2 * inv_det);
+        // The inverse is (t0 t1 t2) transposed: its columns are (t0.x, t1.x, t2.x), ...
+        let c0 = LaneVec3::new(t0.x, t1.x, t2.x);
+        let c1 = LaneVec3::new(t0.y, t1.y, t2.y);
+        let c2 = LaneVec3::new(t0.z, t1.z, t2.z);
+        c0 * rises.x + c1 * rises.y + c2 * rises.z
     }
 }
 
 /// The gradient by central differences (6 evaluations), not normalised: the naive
 /// reference for [`gradient`], with the same treatment of `h` and the same caveat.
 pub fn gradient_central<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
-    let h = usable_step(p, h);
+    let h = usable_step(LaneVec3::from(p), h);
     // Divided by the distance between the points actually sampled (see [`gradient`]).
     let d = |e: Vec3| {
         let (a, b) = (p + e * h, p - e * h);
@@ -114,11 +132,11 @@ pub fn normal_central<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> 
 /// the origin, which then takes the fallback path rather than producing NaN): below that
 /// `p + h` may round back to `p`. No more is needed, since the estimators use the offsets
 /// their samples really have.
-#[inline]
-fn usable_step(p: Vec3, h: f32) -> f32 {
-    let floor = p.abs().max_element() * (2.0 * f32::EPSILON);
+#[inline(always)]
+fn usable_step<L: Lane>(p: LaneVec3<L>, h: L) -> L {
+    let floor = p.abs().max_element() * L::splat(2.0 * f32::EPSILON);
     let h = h.abs();
-    if h >= floor { h } else { floor }
+    L::select(h.ge(floor), h, floor)
 }
 
 /// Normalises without overflow or underflow: dividing by the largest component first keeps
@@ -244,8 +262,8 @@ mod tests {
 
     #[test]
     fn step_is_raised_to_representable() {
-        assert_eq!(usable_step(Vec3::ZERO, -2.0), 2.0);
-        assert!(usable_step(Vec3::splat(1e4), 1e-9) > 0.0);
-        assert_eq!(usable_step(Vec3::ZERO, f32::NAN), 0.0);
+        assert_eq!(usable_step(LaneVec3::from(Vec3::ZERO), -2.0), 2.0);
+        assert!(usable_step(LaneVec3::from(Vec3::splat(1e4)), 1e-9) > 0.0);
+        assert_eq!(usable_step(LaneVec3::from(Vec3::ZERO), f32::NAN), 0.0);
     }
 }

@@ -1,7 +1,7 @@
 //! A shape prepared once for evaluation in a hot loop: its chain of rigid transforms and
 //! uniform scales folded into one affine map.
 
-use glam::{Affine3A, Mat3A, Quat, Vec3, Vec3A};
+use glam::{Affine3A, Mat3A, Quat, Vec3};
 
 use crate::lanes::{Lane, LaneDistance, LaneVec3};
 use crate::{DistanceField, Sdf};
@@ -77,8 +77,13 @@ impl PreparedSdf {
     /// at `|p|`.
     #[inline]
     pub fn evaluation_scale(&self, p: Vec3) -> f32 {
-        let local = Vec3A::from(Vec3::from(self.local(LaneVec3::from(p))));
-        let own = self.factor * local.abs().max_element();
+        self.evaluation_scale_lanes(LaneVec3::from(p))
+    }
+
+    /// [`PreparedSdf::evaluation_scale`] at each lane's point.
+    #[inline(always)]
+    pub fn evaluation_scale_lanes<L: Lane>(&self, p: LaneVec3<L>) -> L {
+        let own = L::splat(self.factor) * self.local(p).abs().max_element();
         if self.to_local.matrix3 == Mat3A::IDENTITY {
             own
         } else {

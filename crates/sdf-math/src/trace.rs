@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use crate::lanes::{Lane, LaneVec3};
 use crate::relaxed::{MAX_STEP_CAP, RelaxedLanes, status};
 use crate::{DistanceField, Ray};
 
@@ -18,7 +19,13 @@ pub const HIT_ULPS: f32 = 4.0;
 /// normal f32), so that thresholds built on it stay positive.
 #[inline]
 pub fn position_rounding(p: Vec3) -> f32 {
-    (f32::EPSILON * p.abs().max_element()).max(f32::MIN_POSITIVE)
+    position_rounding_lanes(LaneVec3::from(p))
+}
+
+/// [`position_rounding`] of each lane's point.
+#[inline(always)]
+pub fn position_rounding_lanes<L: Lane>(p: LaneVec3<L>) -> L {
+    (L::splat(f32::EPSILON) * p.abs().max_element()).max(L::splat(f32::MIN_POSITIVE))
 }
 
 /// Sphere tracing parameters.
