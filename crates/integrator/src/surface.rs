@@ -513,6 +513,16 @@ impl SurfaceScratch {
     }
 }
 
+/// Which of the field evaluations of [`HitsOnObject`] a round of its loop has just made.
+enum Round<L: Lane> {
+    /// At the hit and ahead of it.
+    Start,
+    /// Around the start, for its normal, and at the start.
+    Normal(Start<L>, Tetrahedron<L>),
+    /// At the point projected along the normal.
+    Projection(Projection<L>),
+}
+
 /// The kernel of [`SurfacePoint::at_hits`] for the hits on one object: the stages of
 /// [`SurfacePoint::new`] on a vector of hits at a time, a hit per lane, with the field
 /// values they ask for evaluated as vectors (7, and an 8th where some lane's point
@@ -570,21 +580,42 @@ impl LaneKernel for HitsOnObject<'_> {
             let precision =
                 HitPrecision::at_lanes(sdf, hit, L::load(&epsilon[..lanes]), from_inside);
             let approach = Approach::new(hit, wo, precision);
-            let start = approach.start(sdf.distance_lanes(hit), sdf.distance_lanes(approach.ahead));
-            let tetrahedron = Tetrahedron::around(start.point, approach.h);
-            let q = tetrahedron.points();
-            let grad = tetrahedron.gradient([
-                sdf.distance_lanes(q[0]),
-                sdf.distance_lanes(q[1]),
-                sdf.distance_lanes(q[2]),
-                sdf.distance_lanes(q[3]),
-            ]);
-            let f_start = sdf.distance_lanes(start.point);
-            let projection = approach.project(start, grad, f_start);
-            let f_p = if L::any(projection.moved) {
-                L::select(projection.moved, sdf.distance_lanes(projection.p), f_start)
-            } else {
-                f_start
+            // The field is evaluated at one place in the loop below, in three rounds (2,
+            // 5, then 1 point where some lane moves): each evaluation inlines the whole
+            // primitive, and the 8 inlined copies per SIMD level of straight-line code
+            // took LLVM over four minutes to compile.
+            let mut points = [hit, approach.ahead, hit, hit, hit];
+            let mut values = [L::splat(0.0); 5];
+            let mut count = 2;
+            let mut round = Round::Start;
+            let (projection, f_p) = loop {
+                for (value, &point) in values.iter_mut().zip(&points).take(count) {
+                    *value = sdf.distance_lanes(point);
+                }
+                round = match round {
+                    Round::Start => {
+                        let start = approach.start(values[0], values[1]);
+                        let tetrahedron = Tetrahedron::around(start.point, approach.h);
+                        let [q0, q1, q2, q3] = tetrahedron.points();
+                        points = [q0, q1, q2, q3, start.point];
+                        count = 5;
+                        Round::Normal(start, tetrahedron)
+                    }
+                    Round::Normal(start, tetrahedron) => {
+                        let grad =
+                            tetrahedron.gradient([values[0], values[1], values[2], values[3]]);
+                        let projection = approach.project(start, grad, values[4]);
+                        if !L::any(projection.moved) {
+                            break (projection, values[4]);
+                        }
+                        // A lane that did not move has its start as `p`, and evaluating it
+                        // again gives `f_start`'s bits.
+                        points[0] = projection.p;
+                        count = 1;
+                        Round::Projection(projection)
+                    }
+                    Round::Projection(projection) => break (projection, values[0]),
+                };
             };
             let s = approach.finish(&projection, f_p);
             let mut out = [[0.0; MAX_LANES]; 9];
