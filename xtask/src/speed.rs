@@ -20,6 +20,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
+use lueur::integrator::Execution;
 use lueur::sdf_math::SimdLevel;
 
 use crate::memory::build_lueur;
@@ -277,7 +278,7 @@ fn level_table(
     flag: bool,
 ) -> Result<String> {
     let mut t = String::new();
-    let detected = SimdLevel::detect();
+    let detected = Execution::default().simd;
     writeln!(
         t,
         "By SIMD level, `{MITSUBA_SCENE}` (`--simd LEVEL`; the default is `{}`):\n",
@@ -380,7 +381,7 @@ fn mitsuba_paragraph(peer: &Peer) -> String {
 /// the commit and the command, as a list.
 fn machine(md: &mut String, peer: &Peer, command: &str) -> Result<()> {
     let cores = std::thread::available_parallelism().map_or(0, std::num::NonZero::get);
-    let level = SimdLevel::detect();
+    let level = Execution::default().simd;
     let mitsuba = match peer {
         Peer::Measured(version) => format!("{version}, every core ({cores})"),
         Peer::Skipped(why) => (*why).to_owned(),
@@ -389,7 +390,7 @@ fn machine(md: &mut String, peer: &Peer, command: &str) -> Result<()> {
     writeln!(md, "- SIMD features: {}", simd_features())?;
     writeln!(
         md,
-        "- lueur's lane path (`SimdLevel::detect()`): {level:?}, {} lanes",
+        "- lueur's lane path (`Execution::default().simd`): {level:?}, {} lanes",
         level.lanes()
     )?;
     writeln!(md, "- threads: lueur {THREADS} (`-t {THREADS}`)")?;

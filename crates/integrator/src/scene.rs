@@ -29,7 +29,8 @@ pub struct PreparedScene {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Execution {
     /// The vectors of fast marching's streams; a level this CPU lacks runs on the widest
-    /// it has ([`SimdLevel::detect`]).
+    /// it has ([`SimdLevel::detect`]). By default the widest of at most
+    /// [`Execution::LANES`] lanes.
     pub simd: SimdLevel,
     /// Paths per wave (at least 1): enough to keep a vector's lanes busy while paths
     /// end, few enough that a wave's rays stay in cache.
@@ -40,12 +41,20 @@ impl Execution {
     /// Paths per wave by default: 16 vectors of the widest lanes, measured against 64 and
     /// 1024 in docs/PERFORMANCE.md.
     pub const WAVE: usize = 256;
+
+    /// The widest vectors the renderer uses by default: on the one AVX-512 machine
+    /// measured (a 2-core AMD EPYC, whose cores run a 16-lane instruction as two halves),
+    /// AVX2's 8 lanes rendered every shipped scene 10-18% faster than AVX-512's 16, whose
+    /// kernels took a quarter more time; a wider wave did not close the gap
+    /// (docs/PERFORMANCE.md, "Eight lanes or sixteen"). `--simd avx512` still runs them,
+    /// to the same bits.
+    pub const LANES: usize = 8;
 }
 
 impl Default for Execution {
     fn default() -> Execution {
         Execution {
-            simd: SimdLevel::detect(),
+            simd: SimdLevel::widest_up_to(Execution::LANES),
             wave: Execution::WAVE,
         }
     }

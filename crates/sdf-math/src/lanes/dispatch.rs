@@ -55,15 +55,26 @@ impl SimdLevel {
 
     /// The widest level this CPU offers.
     pub fn detect() -> SimdLevel {
+        Self::widest_up_to(usize::MAX)
+    }
+
+    /// The widest instruction-set level this CPU offers with at most `lanes` lanes; where
+    /// it has none, `Portable` if `lanes` allows its 8, else `Scalar`.
+    pub fn widest_up_to(lanes: usize) -> SimdLevel {
         let best = [
             SimdLevel::Avx512,
             SimdLevel::Avx2,
             SimdLevel::Sse,
             SimdLevel::Neon,
         ];
+        let fallback = if lanes >= SimdLevel::Portable.lanes() {
+            SimdLevel::Portable
+        } else {
+            SimdLevel::Scalar
+        };
         best.into_iter()
-            .find(|level| level.is_available())
-            .unwrap_or(SimdLevel::Portable)
+            .find(|level| level.lanes() <= lanes && level.is_available())
+            .unwrap_or(fallback)
     }
 
     /// This level where the CPU has it, else the widest it has ([`SimdLevel::detect`]):

@@ -339,4 +339,27 @@ mod tests {
             }
         }
     }
+
+    /// A cap on the lanes picks the widest available level under it, and without a cap
+    /// it is `detect`.
+    #[test]
+    fn widest_up_to_respects_its_cap_and_availability() {
+        assert_eq!(SimdLevel::widest_up_to(usize::MAX), SimdLevel::detect());
+        assert_eq!(SimdLevel::widest_up_to(1), SimdLevel::Scalar);
+        for cap in [1, 3, 4, 7, 8, 15, 16, 64] {
+            let level = SimdLevel::widest_up_to(cap);
+            assert!(level.is_available(), "{cap}: {level:?}");
+            assert!(level.lanes() <= cap, "{cap}: {level:?}");
+            let wider = SimdLevel::available()
+                .into_iter()
+                .filter(|l| *l != SimdLevel::Portable && l.lanes() <= cap)
+                .map(SimdLevel::lanes)
+                .max()
+                .unwrap_or(1);
+            assert!(
+                level.lanes() >= wider,
+                "{cap}: {level:?} under {wider} lanes"
+            );
+        }
+    }
 }
