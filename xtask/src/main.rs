@@ -80,7 +80,7 @@ enum Command {
     },
     /// Compare lueur with Mitsuba 3 on cornell-spheres (correctness against
     /// a Mitsuba reference, speed and MSE x time); needs `pip install
-    /// mitsuba`; writes docs/PEERS.md.
+    /// mitsuba numpy`; writes docs/PEERS.md.
     Peers {
         /// 64x64 and few samples, to check the pipeline.
         #[arg(long)]

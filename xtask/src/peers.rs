@@ -4,7 +4,7 @@
 //!
 //! Mitsuba is a peer for measurement only, never a dependency: this report
 //! runs `xtask/peers/mitsuba_render.py` with the machine's `python3` where
-//! `pip install mitsuba` was done (for `llvm_ad_rgb`, also Debian's
+//! `pip install mitsuba numpy` was done (for `llvm_ad_rgb`, also Debian's
 //! `libllvm19`; `DRJIT_LIBLLVM_PATH` is set to it when found), and refuses
 //! to run otherwise. CI does not run it.
 //!
@@ -169,8 +169,9 @@ pub fn run(quick: bool) -> Result<()> {
     let plan = PLANS.pick(quick);
     ensure!(
         mitsuba_installed()?,
-        "Mitsuba 3 is not installed for python3: `pip install mitsuba` (and, for llvm_ad_rgb, \
-         Debian's libllvm19). It is a peer for this report only, never a dependency of lueur."
+        "Mitsuba 3 (with numpy, which its multi-pass renders use) is not installed for \
+         python3: `pip install mitsuba numpy` (and, for llvm_ad_rgb, Debian's libllvm19). It is \
+         a peer for this report only, never a dependency of lueur."
     );
     let work = cache_dir()?.join("peers");
     std::fs::create_dir_all(&work)?;
@@ -573,10 +574,11 @@ fn summary(md: &mut String, plan: &Plan, results: &[(Config, Vec<Measured>)]) ->
     Ok(())
 }
 
-/// Whether `python()` can import Mitsuba 3.
+/// Whether `python()` can import Mitsuba 3, and numpy, which `mitsuba_render.py`'s
+/// multi-pass renders need.
 pub fn mitsuba_installed() -> Result<bool> {
     let check = python()
-        .args(["-c", "import mitsuba"])
+        .args(["-c", "import mitsuba, numpy"])
         .output()
         .context("cannot run python3")?;
     Ok(check.status.success())

@@ -86,7 +86,7 @@ pub fn run(
     } else if mitsuba_installed()? {
         Peer::Measured(mitsuba_version())
     } else {
-        Peer::Skipped("not installed for python3 (`pip install mitsuba`): lueur only")
+        Peer::Skipped("not installed for python3 (`pip install mitsuba numpy`): lueur only")
     };
     if let Peer::Skipped(why) = &peer {
         eprintln!("Mitsuba 3: {why}");
