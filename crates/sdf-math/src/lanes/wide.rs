@@ -203,6 +203,11 @@ pub trait MaskLane:
     fn select(self, if_true: f32, if_false: f32) -> f32;
     /// Whether any of `lanes` is set, in the reduction this form compiles best to.
     fn any<const N: usize>(lanes: [Self; N]) -> bool;
+    /// Lane `i` of `lanes` in bit `i`.
+    #[inline(always)]
+    fn bits<const N: usize>(lanes: [Self; N]) -> u32 {
+        (lanes.iter().enumerate()).fold(0, |acc, (i, &m)| acc | (m.bit() << i))
+    }
 }
 
 /// A `bool` per lane: AVX-512 keeps these in its mask registers, which its compares write
@@ -252,6 +257,33 @@ impl MaskLane for u32 {
     fn any<const N: usize>(lanes: [u32; N]) -> bool {
         // A reduction without an early exit, which vectorizes to one test.
         lanes.iter().fold(0, |acc, &m| acc | m) != 0
+    }
+
+    /// On x86-64, `movmskps` per 4 lanes: LLVM does not recognise the shift-and-or
+    /// reduction as one, and built the bits in some thirty shuffles and compares.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn bits<const N: usize>(lanes: [u32; N]) -> u32 {
+        // SSE is part of the x86-64 baseline, so the check is a constant.
+        let Some(sse) = pulp::core_arch::x86::Sse::try_new() else {
+            return (lanes.iter().enumerate()).fold(0, |acc, (i, &m)| acc | (m.bit() << i));
+        };
+        let mut bits = 0;
+        let mut chunks = lanes.chunks_exact(4);
+        for (k, c) in chunks.by_ref().enumerate() {
+            let v = sse._mm_setr_ps(
+                f32::from_bits(c[0]),
+                f32::from_bits(c[1]),
+                f32::from_bits(c[2]),
+                f32::from_bits(c[3]),
+            );
+            bits |= (sse._mm_movemask_ps(v) as u32) << (4 * k);
+        }
+        let done = N - chunks.remainder().len();
+        for (i, &m) in chunks.remainder().iter().enumerate() {
+            bits |= m.bit() << (done + i);
+        }
+        bits
     }
 }
 
@@ -308,7 +340,7 @@ impl<T: MaskLane, const N: usize> LaneMask<N> for Mask<T, N> {
 
     #[inline(always)]
     fn bits(self) -> u32 {
-        (self.0.iter().enumerate()).fold(0, |acc, (i, &m)| acc | (m.bit() << i))
+        T::bits(self.0)
     }
 
     #[inline(always)]
