@@ -38,13 +38,13 @@ pub struct Execution {
 }
 
 impl Execution {
-    /// Paths per wave by default: 16 vectors of the widest lanes, measured against 64 and
-    /// 1024 in docs/PERFORMANCE.md.
+    /// Paths per wave by default: 32 vectors of 8 lanes, measured against 16 to 4096
+    /// paths in docs/PERFORMANCE.md.
     pub const WAVE: usize = 256;
 
     /// The widest vectors the renderer uses by default: on the one AVX-512 machine
     /// measured (a 2-core AMD EPYC, whose cores run a 16-lane instruction as two halves),
-    /// AVX2's 8 lanes rendered every shipped scene 10-18% faster than AVX-512's 16, whose
+    /// AVX2's 8 lanes rendered the shipped scenes 1.10-1.19x as fast as AVX-512's 16, whose
     /// kernels took a quarter more time; a wider wave did not close the gap
     /// (docs/PERFORMANCE.md, "Eight lanes or sixteen"). `--simd avx512` still runs them,
     /// to the same bits.
