@@ -206,8 +206,14 @@ pub trait MaskLane:
     /// Lane `i` of `lanes` in bit `i`.
     #[inline(always)]
     fn bits<const N: usize>(lanes: [Self; N]) -> u32 {
-        (lanes.iter().enumerate()).fold(0, |acc, (i, &m)| acc | (m.bit() << i))
+        bits_from(&lanes, 0)
     }
+}
+
+/// `lanes[i]` in bit `first + i`, one lane at a time.
+#[inline(always)]
+fn bits_from<T: MaskLane>(lanes: &[T], first: usize) -> u32 {
+    (lanes.iter().enumerate()).fold(0, |acc, (i, &m)| acc | (m.bit() << (first + i)))
 }
 
 /// A `bool` per lane: AVX-512 keeps these in its mask registers, which its compares write
@@ -266,7 +272,7 @@ impl MaskLane for u32 {
     fn bits<const N: usize>(lanes: [u32; N]) -> u32 {
         // SSE is part of the x86-64 baseline, so the check is a constant.
         let Some(sse) = pulp::core_arch::x86::Sse::try_new() else {
-            return (lanes.iter().enumerate()).fold(0, |acc, (i, &m)| acc | (m.bit() << i));
+            return bits_from(&lanes, 0);
         };
         let mut bits = 0;
         let mut chunks = lanes.chunks_exact(4);
@@ -279,11 +285,7 @@ impl MaskLane for u32 {
             );
             bits |= (sse._mm_movemask_ps(v) as u32) << (4 * k);
         }
-        let done = N - chunks.remainder().len();
-        for (i, &m) in chunks.remainder().iter().enumerate() {
-            bits |= m.bit() << (done + i);
-        }
-        bits
+        bits | bits_from(chunks.remainder(), N - chunks.remainder().len())
     }
 }
 
