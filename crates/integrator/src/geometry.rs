@@ -161,12 +161,16 @@ impl LaneKernel for Clip<'_> {
         let lanes = L::LANES.min(MAX_LANES);
         let objects = geometry.order.len();
         let mut clipped = std::mem::take(&mut batch.clipped);
-        clipped.resize(lanes * objects, 0);
+        // A slot past each lane's last, for the write of an object it does not keep.
+        let stride = objects + 1;
+        clipped.resize(lanes * stride, 0);
         let mut start = 0;
+        // Kept across groups: lanes past a short last group hold an earlier ray, finite
+        // and never read (`live`).
+        let mut v = [[0f32; MAX_LANES]; 10];
         while start < batch.queued.len() {
             let group = start..(start + lanes).min(batch.queued.len());
             start = group.end;
-            let mut v = [[0f32; MAX_LANES]; 10];
             for (lane, (_, ray, p)) in batch.queued[group.clone()].iter().enumerate() {
                 let values = [
                     ray.origin.x,
@@ -205,12 +209,12 @@ impl LaneKernel for Clip<'_> {
                 lo = L::select(keep, L::select(seen, lo.min(t0), t0), lo);
                 hi = L::select(keep, L::select(seen, hi.max(t1), t1), hi);
                 seen = L::or(seen, keep);
-                let mut kept = L::bits(keep) & live;
-                while kept != 0 {
-                    let lane = kept.trailing_zeros() as usize;
-                    kept &= kept - 1;
-                    clipped[lane * objects + count[lane]] = k as u32;
-                    count[lane] += 1;
+                // Every lane writes, and only the lanes that keep the object advance: no
+                // branch on the mask, whose bits are as random as the rays.
+                let kept = L::bits(keep) & live;
+                for (lane, count) in count.iter_mut().enumerate().take(lanes) {
+                    clipped[lane * stride + *count] = k as u32;
+                    *count += (kept >> lane & 1) as usize;
                 }
             }
             let (mut los, mut his) = ([0f32; MAX_LANES], [0f32; MAX_LANES]);
@@ -224,7 +228,7 @@ impl LaneKernel for Clip<'_> {
                 }
                 let (t_min, t_max) = (los[lane], his[lane]);
                 let first = batch.candidates.len() as u32;
-                let own = &clipped[lane * objects..lane * objects + count[lane]];
+                let own = &clipped[lane * stride..lane * stride + count[lane]];
                 batch.candidates.extend_from_slice(own);
                 batch.spans.push((first, batch.candidates.len() as u32));
                 batch.rays.push(ray);
