@@ -5,8 +5,10 @@
 
 use glam::{Vec2, Vec3};
 use lueur_sampling::{
-    DiscreteDistribution, Frame, cosine_hemisphere_pdf, sample_cosine_hemisphere,
+    DirectionSample, DiscreteDistribution, Frame, cosine_hemisphere_pdf, sample_cosine_hemisphere,
+    sample_sphere_light_lanes,
 };
+use lueur_sdf_math::{Lane, LaneKernel, LaneVec3, MAX_LANES, SimdLevel, write_lane};
 
 use lueur_scene::{EmitterSample, Light, QuadSampling};
 
@@ -25,6 +27,8 @@ pub(crate) enum Emitter {
 pub(crate) struct LightSampler {
     emitters: Vec<Emitter>,
     choice: Option<DiscreteDistribution>,
+    /// Whether any emitter is a sphere light.
+    spheres: bool,
 }
 
 impl LightSampler {
@@ -41,7 +45,12 @@ impl LightSampler {
         // Uniform choice: power-proportional choice needs the sky's power,
         // which depends on the scene's extent; measured first, changed later.
         let choice = DiscreteDistribution::uniform(emitters.len());
-        LightSampler { emitters, choice }
+        let spheres = lights.iter().any(|l| l.as_sphere().is_some());
+        LightSampler {
+            emitters,
+            choice,
+            spheres,
+        }
     }
 
     /// Whether there is anything to choose.
@@ -89,6 +98,33 @@ impl Emitters<'_> {
         u_choice: f32,
         u: Vec2,
     ) -> Option<(EmitterSample, Option<usize>)> {
+        self.sample_drawn(p, n, u_choice, u, None)
+    }
+
+    /// The centre and radius of the light `u_choice` makes [`Emitters::sample`] aim at,
+    /// where that is a sphere light: whose direction sample a wave draws in lanes.
+    #[inline]
+    pub fn chosen_sphere(&self, u_choice: f32) -> Option<(Vec3, f32)> {
+        if !self.sampler.spheres {
+            return None;
+        }
+        match self.sampler.choose(u_choice)?.0 {
+            Emitter::Light(i) => self.lights[i].as_sphere(),
+            Emitter::Sky => None,
+        }
+    }
+
+    /// [`Emitters::sample`], where the chosen sphere light's direction sample was `drawn`
+    /// already ([`Light::sample_drawn`]).
+    #[inline]
+    pub fn sample_drawn(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        u_choice: f32,
+        u: Vec2,
+        drawn: Option<Option<DirectionSample>>,
+    ) -> Option<(EmitterSample, Option<usize>)> {
         let (emitter, pmf) = self.sampler.choose(u_choice)?;
         match emitter {
             Emitter::Sky => {
@@ -110,7 +146,7 @@ impl Emitters<'_> {
                 ))
             }
             Emitter::Light(i) => {
-                let s = self.lights[i].sample(p, u, self.quad_sampling)?;
+                let s = self.lights[i].sample_drawn(p, u, self.quad_sampling, drawn)?;
                 Some((
                     EmitterSample {
                         pdf: s.pdf * pmf,
@@ -155,5 +191,106 @@ impl Emitters<'_> {
             Emitter::Sky => cosine_hemisphere_pdf(n.dot(wi)),
             Emitter::Light(i) => self.lights[i].pdf(p, wi, self.quad_sampling),
         }
+    }
+}
+
+/// The sphere lights' direction samples that a wave's next-event estimation asks for,
+/// drawn together, a request per lane ([`sample_sphere_light_lanes`]): each is the bits
+/// [`lueur_sampling::sample_sphere_light`] gives for it, whatever its company and the
+/// SIMD level. One sample is a chain of dependent square roots and divisions; in lanes,
+/// a vector of them costs about what one does.
+#[derive(Debug, Default)]
+pub(crate) struct SphereDraws {
+    /// Per request: the shading point, the sphere's centre and radius, `u`.
+    requests: Vec<[f32; 9]>,
+    /// Per request, after [`SphereDraws::draw`]: its sample.
+    pub drawn: Vec<Option<DirectionSample>>,
+}
+
+impl SphereDraws {
+    pub fn clear(&mut self) {
+        self.requests.clear();
+        self.drawn.clear();
+    }
+
+    /// Asks for a sample of the sphere `(center, radius)` from `p` with `u`; its index in
+    /// `drawn`.
+    pub fn request(&mut self, p: Vec3, (center, radius): (Vec3, f32), u: Vec2) -> usize {
+        self.requests.push([
+            p.x, p.y, p.z, center.x, center.y, center.z, radius, u.x, u.y,
+        ]);
+        self.requests.len() - 1
+    }
+
+    /// Draws every request's sample on `level` (the widest available where it is not).
+    pub fn draw(&mut self, level: SimdLevel) {
+        self.drawn.clear();
+        // The level is available: `or_widest` says so.
+        let _ = level.or_widest().dispatch(DrawSpheres {
+            requests: &self.requests,
+            drawn: &mut self.drawn,
+        });
+    }
+}
+
+/// The kernel of [`SphereDraws::draw`].
+struct DrawSpheres<'a> {
+    requests: &'a [[f32; 9]],
+    drawn: &'a mut Vec<Option<DirectionSample>>,
+}
+
+impl LaneKernel for DrawSpheres<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let DrawSpheres { requests, drawn } = self;
+        let n = requests.len();
+        let mut start = 0;
+        // Whole rows in and out, whatever the group's size: a load or store of a length
+        // not known when compiling is a call to `memcpy`. Lanes past a short last group
+        // hold an earlier request, finite, and are not read back.
+        let width = L::LANES.min(MAX_LANES);
+        let mut rows = [[0f32; MAX_LANES]; 9];
+        while start < n {
+            let end = (start + L::LANES).min(n);
+            fill_rows(&requests[start..end], &mut rows);
+            let mut lanes = [L::splat(0.0); 9];
+            for (lane, row) in lanes.iter_mut().zip(&rows) {
+                *lane = L::load(&row[..width]);
+            }
+            let [px, py, pz, cx, cy, cz, radius, u0, u1] = lanes;
+            let (p, center) = (LaneVec3::new(px, py, pz), LaneVec3::new(cx, cy, cz));
+            let s = sample_sphere_light_lanes(p, center, radius, [u0, u1]);
+            let mut out = [[0f32; MAX_LANES]; 11];
+            let values = [
+                s.wi.x, s.wi.y, s.wi.z, s.distance, s.pdf, s.point.x, s.point.y, s.point.z,
+                s.normal.x, s.normal.y, s.normal.z,
+            ];
+            for (row, v) in out.iter_mut().zip(values) {
+                v.store(&mut row[..width]);
+            }
+            let valid = L::bits(s.valid);
+            drawn.extend((0..end - start).map(|lane| {
+                (valid >> lane & 1 == 1).then(|| DirectionSample {
+                    wi: Vec3::new(out[0][lane], out[1][lane], out[2][lane]),
+                    distance: out[3][lane],
+                    pdf: out[4][lane],
+                    point: Vec3::new(out[5][lane], out[6][lane], out[7][lane]),
+                    normal: Vec3::new(out[8][lane], out[9][lane], out[10][lane]),
+                })
+            }));
+            start = end;
+        }
+    }
+}
+
+/// Puts request `i` of `group` in lane `i` of `rows`. Out of line, as
+/// `RelaxedStream::take` is: inlined, the optimiser forwards the scalar stores into the
+/// kernel's vector loads and builds each row from its lanes.
+#[inline(never)]
+fn fill_rows(group: &[[f32; 9]], rows: &mut [[f32; MAX_LANES]; 9]) {
+    for (lane, request) in group.iter().enumerate() {
+        write_lane(rows, lane, *request);
     }
 }

@@ -16,6 +16,7 @@ use crate::surface::{March, SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::{PathRay, ShadowRay, TraceScratch, Tracing};
 use lueur_scene::RenderSettings;
 
+use crate::light_sampler::SphereDraws;
 use crate::{Hit, PreparedScene, TraceCounters};
 
 /// Counters per kind of ray.
@@ -116,6 +117,16 @@ struct Shaded {
     roulette: f32,
 }
 
+/// A vertex waiting to be shaded: its path, where it is, its numbers, and its sphere-light
+/// sample's index in the wave's [`SphereDraws`] where next-event estimation chose one.
+struct Pending {
+    path: usize,
+    on_surface: SurfaceHit,
+    surface: SurfacePoint,
+    u: VertexSample,
+    sphere: Option<usize>,
+}
+
 /// A thread's buffers for [`radiance_wave`], kept from one wave to the next.
 #[derive(Default)]
 pub(crate) struct WaveScratch {
@@ -127,6 +138,8 @@ pub(crate) struct WaveScratch {
     surface_hits: Vec<(Ray, SurfaceHit)>,
     surfaces: Vec<SurfacePoint>,
     surface_scratch: SurfaceScratch,
+    pending: Vec<Pending>,
+    spheres: SphereDraws,
     shaded: Vec<Shaded>,
     shadow: ShadowQueue,
     free: Vec<bool>,
@@ -142,21 +155,33 @@ struct ShadowQueue {
     lights: Vec<(ShadowRay, Vec3)>,
 }
 
-/// Shades path `index` where it met `on_surface` at `surface`: the shadow rays the vertex
-/// proposes (queued in `shadow`; at a diffuse vertex the delta lights', then next-event
-/// estimation's where the strategy uses it) and the direction it scatters in.
+/// The material of the object a path met.
+fn material_at(scene: &PreparedScene, on_surface: SurfaceHit) -> Material {
+    scene.scene().materials[scene.scene().objects[on_surface.object].material]
+}
+
+/// Shades the path of `pending` (`path`) where it met its surface: the shadow rays the
+/// vertex proposes (queued in `shadow`; at a diffuse vertex the delta lights', then
+/// next-event estimation's where the strategy uses it, its sphere-light sample taken from
+/// `spheres` where the wave drew it) and the direction it scatters in.
 fn shade(
     estimator: &Estimator<'_>,
     lighting: &Lighting<'_>,
-    (index, path): (usize, &Path),
-    (on_surface, surface): (SurfaceHit, SurfacePoint),
-    u: &VertexSample,
+    (pending, path): (&Pending, &Path),
+    spheres: &SphereDraws,
     shadow: &mut ShadowQueue,
 ) -> Shaded {
     let Estimator {
         scene, settings, ..
     } = *estimator;
-    let material = scene.scene().materials[scene.scene().objects[on_surface.object].material];
+    let &Pending {
+        path: index,
+        on_surface,
+        surface,
+        ref u,
+        sphere,
+    } = pending;
+    let material = material_at(scene, on_surface);
     let vertex = Vertex {
         at: surface,
         wo: -path.ray.dir,
@@ -169,7 +194,7 @@ fn shade(
             shadow.lights.clear();
             lighting.delta_lights(&vertex, &mut shadow.lights);
             let nee = strategy::uses_next_event(settings.strategy)
-                .then(|| lighting.next_event(&vertex, u))
+                .then(|| lighting.next_event(&vertex, u, sphere.map(|k| spheres.drawn[k])))
                 .flatten();
             let next_event = nee.is_some();
             for (ray, contribution) in shadow.lights.drain(..).chain(nee) {
@@ -263,9 +288,8 @@ pub(crate) fn radiance_wave(
             &mut s.surfaces,
         );
 
-        s.shaded.clear();
-        s.shadow.rays.clear();
-        s.shadow.contributions.clear();
+        s.pending.clear();
+        s.spheres.clear();
         let mut surfaces = s.surfaces.iter();
         for (&i, &hit) in s.active.iter().zip(&s.hits) {
             let path = &mut s.paths[i];
@@ -281,12 +305,34 @@ pub(crate) fn radiance_wave(
                 .next()
                 .expect("a shading point for each hit that scatters");
             let u = VertexSample::draw(&mut samplers[i], ids[i].pixel, ids[i].index, path.depth);
+            // Next-event estimation toward a sphere light: its sample is drawn below, with
+            // the wave's others.
+            let next_event = strategy::uses_next_event(settings.strategy)
+                && matches!(material_at(scene, on_surface), Material::Lambertian { .. });
+            let sphere = next_event
+                .then(|| lighting.emitters.chosen_sphere(u.emitter_choice))
+                .flatten()
+                .map(|sphere| s.spheres.request(surface.p, sphere, u.emitter));
+            s.pending.push(Pending {
+                path: i,
+                on_surface,
+                surface,
+                u,
+                sphere,
+            });
+        }
+        s.spheres.draw(tracing.simd);
+
+        s.shaded.clear();
+        s.shadow.rays.clear();
+        s.shadow.contributions.clear();
+        for pending in &s.pending {
+            let path = &s.paths[pending.path];
             s.shaded.push(shade(
                 estimator,
                 &lighting,
-                (i, path),
-                (on_surface, surface),
-                &u,
+                (pending, path),
+                &s.spheres,
                 &mut s.shadow,
             ));
         }

@@ -8,7 +8,7 @@
 
 use glam::{Vec2, Vec3};
 use lueur_materials::{HemisphereSampling, Material};
-use lueur_sampling::{Sampler, power_heuristic};
+use lueur_sampling::{DirectionSample, Sampler, power_heuristic};
 use lueur_sdf_math::{Ray, TraceParams};
 
 use crate::light_sampler::Emitters;
@@ -44,6 +44,7 @@ pub(crate) struct VertexSample {
 
 impl VertexSample {
     /// The numbers of vertex `depth` of sample `index` of `pixel`.
+    #[inline]
     pub fn draw(sampler: &mut Sampler, pixel: [u32; 2], index: u32, depth: u32) -> VertexSample {
         sampler.start_pixel_sample(pixel, index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
         let emitter_choice = sampler.next_1d();
@@ -135,6 +136,7 @@ pub(crate) fn mirror(v: &Vertex, u_bsdf: Vec2) -> Option<Scatter> {
 }
 
 /// The direction of `strategy` at a diffuse vertex.
+#[inline]
 pub(crate) fn scatter(
     strategy: Strategy,
     emitters: &Emitters<'_>,
@@ -271,6 +273,7 @@ impl<'a> Lighting<'a> {
     /// The light every delta light would bring, with the shadow ray each needs (a delta
     /// light can be reached no other way), pushed to `out` in the lights' order; the
     /// vertex gathers the sum of those whose ray is free, in that order.
+    #[inline]
     pub fn delta_lights(&self, v: &Vertex, out: &mut Vec<(ShadowRay, Vec3)>) {
         let (n, wo) = (v.at.n, v.wo);
         for light in &self.scene.scene().lights {
@@ -297,11 +300,20 @@ impl<'a> Lighting<'a> {
     /// Next-event estimation toward one chosen emitter, weighted against `mis`'s BSDF
     /// sampling by [`next_event_weight`]: what it brings if its shadow ray is free, with
     /// that ray; `None` where it brings nothing whatever the ray finds.
-    pub fn next_event(&self, v: &Vertex, u: &VertexSample) -> Option<(ShadowRay, Vec3)> {
+    ///
+    /// `drawn` is the chosen sphere light's direction sample where the wave drew it
+    /// already ([`crate::light_sampler::SphereDraws`]), `None` otherwise.
+    #[inline]
+    pub fn next_event(
+        &self,
+        v: &Vertex,
+        u: &VertexSample,
+        drawn: Option<Option<DirectionSample>>,
+    ) -> Option<(ShadowRay, Vec3)> {
         let (n, wo) = (v.at.n, v.wo);
-        let (es, light) = self
-            .emitters
-            .sample(v.at.p, n, u.emitter_choice, u.emitter)?;
+        let (es, light) =
+            self.emitters
+                .sample_drawn(v.at.p, n, u.emitter_choice, u.emitter, drawn)?;
         let f = v.material.eval(wo, es.wi, n);
         let cos = n.dot(es.wi).abs();
         if f == Vec3::ZERO || cos == 0.0 || es.radiance == Vec3::ZERO {

@@ -2,6 +2,7 @@
 //! z-up local space in which every warp of this crate is written.
 
 use glam::Vec3;
+use lueur_sdf_math::{Lane, LaneVec3};
 
 /// A right-handed orthonormal basis: `s` and `t` span the tangent plane and
 /// `n` is the normal (`s x t = n`). Warps produce directions in the local frame
@@ -22,16 +23,17 @@ impl Frame {
     ///
     /// Duff, Burgess, Christensen, Hery, Kensler, Liani and Villemin 2017,
     /// "Building an Orthonormal Basis, Revisited", JCGT 6(1), Listing 3: the
-    /// `copysign` form, which stays accurate as `n.z -> -1` (the singularity of
-    /// Frisvad's original construction). `n` must be unit length; the result is
-    /// then orthonormal to within a few ulps.
+    /// form with the sign of `n.z`, which stays accurate as `n.z -> -1` (the
+    /// singularity of Frisvad's original construction). `n` must be unit length;
+    /// the result is then orthonormal to within a few ulps.
+    #[inline]
     pub fn from_normal(n: Vec3) -> Self {
-        let sign = 1.0f32.copysign(n.z);
-        let a = -1.0 / (sign + n.z);
-        let b = n.x * n.y * a;
-        let s = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-        let t = Vec3::new(b, sign + n.y * n.y * a, -n.y);
-        Self { s, t, n }
+        let FrameLanes { s, t, n } = FrameLanes::from_normal(n.into());
+        Self {
+            s: s.into(),
+            t: t.into(),
+            n: n.into(),
+        }
     }
 
     /// Local (z-up) to world: `v.x * s + v.y * t + v.z * n`.
@@ -44,6 +46,36 @@ impl Frame {
     #[inline]
     pub fn to_local(&self, v: Vec3) -> Vec3 {
         Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    }
+}
+
+/// [`Frame`] for a normal per lane: the one definition of the construction, whose
+/// one-lane instance [`Frame::from_normal`] is.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FrameLanes<L> {
+    pub s: LaneVec3<L>,
+    pub t: LaneVec3<L>,
+    pub n: LaneVec3<L>,
+}
+
+impl<L: Lane> FrameLanes<L> {
+    /// [`Frame::from_normal`], per lane. The sign is that of `n.z`, with `-0` taken as
+    /// positive: both signs give an orthonormal frame at `n.z = 0`.
+    #[inline(always)]
+    pub fn from_normal(n: LaneVec3<L>) -> Self {
+        let one = L::splat(1.0);
+        let sign = L::select(n.z.lt(L::splat(0.0)), -one, one);
+        let a = -one / (sign + n.z);
+        let b = n.x * n.y * a;
+        let s = LaneVec3::new(one + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let t = LaneVec3::new(b, sign + n.y * n.y * a, -n.y);
+        Self { s, t, n }
+    }
+
+    /// [`Frame::to_world`], per lane.
+    #[inline(always)]
+    pub fn to_world(self, v: LaneVec3<L>) -> LaneVec3<L> {
+        self.s * v.x + self.t * v.y + self.n * v.z
     }
 }
 

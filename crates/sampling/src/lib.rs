@@ -17,6 +17,13 @@
 //! edges); it works in `f32` with [`glam`] vectors, and directions are in a
 //! local z-up [`Frame`] unless stated otherwise.
 //!
+//! **Lanes.** Where a renderer draws many samples of one kind together, the
+//! routine is written once over `lueur-sdf-math`'s `Lane` number type (one
+//! `f32`, or a SIMD vector of them), and the scalar function is its one-lane
+//! instance: [`sample_sphere_light_lanes`] gives, in every lane, the bits
+//! [`sample_sphere_light`] gives. Its azimuth's sine and cosine are our own
+//! polynomial (`math.rs`), not libm's, which has no vector form to match.
+//!
 //! **Contract.** Every warp's samples follow its pdf (checked by chi-square
 //! goodness-of-fit tests); every pdf is finite and `>= 0`; no NaN or infinity
 //! ever leaves a warp; a zero pdf means "no weight". Every `u` is accepted in
@@ -73,7 +80,7 @@ pub use glam::{Vec2, Vec3};
 
 pub use discrete::DiscreteDistribution;
 pub use frame::Frame;
-pub use light::DirectionSample;
+pub use light::{DirectionSample, DirectionSampleLanes};
 pub use math::ONE_MINUS_EPSILON;
 pub use mis::{balance_heuristic, power_heuristic};
 pub use quad_light::{
@@ -82,7 +89,9 @@ pub use quad_light::{
 };
 pub use sampler::{DIMENSIONS_PER_SAMPLE, Sampler};
 pub use sampler_kind::SamplerKind;
-pub use sphere_light::{sample_sphere_light, sphere_light_pdf, sphere_solid_angle};
+pub use sphere_light::{
+    sample_sphere_light, sample_sphere_light_lanes, sphere_light_pdf, sphere_solid_angle,
+};
 pub use warp::{
     cosine_hemisphere_pdf, invert_cosine_hemisphere, invert_uniform_cone,
     invert_uniform_disk_concentric, invert_uniform_hemisphere, invert_uniform_sphere,

@@ -1,8 +1,9 @@
 //! The result type shared by the light-sampling routines.
 
 use glam::Vec3;
+use lueur_sdf_math::{Lane, LaneVec3};
 
-use crate::math::normalize_with_length;
+use crate::math::{finite_lanes, finite3_lanes, normalize_with_length};
 
 /// A direction sampled toward a light from a shading point `p`, with its
 /// solid-angle pdf.
@@ -25,19 +26,6 @@ pub struct DirectionSample {
 }
 
 impl DirectionSample {
-    /// Builds the sample from `p` toward `point`, checking the invariant.
-    pub(crate) fn toward(p: Vec3, point: Vec3, normal: Vec3, pdf: f32) -> Option<Self> {
-        let (wi, distance) = normalize_with_length(point - p)?;
-        let sample = Self {
-            wi,
-            distance,
-            pdf,
-            point,
-            normal,
-        };
-        sample.is_valid().then_some(sample)
-    }
-
     /// Builds the sample when the pdf depends on the direction and distance.
     pub(crate) fn toward_with(
         p: Vec3,
@@ -64,5 +52,73 @@ impl DirectionSample {
             && self.wi.is_finite()
             && self.point.is_finite()
             && self.normal.is_finite()
+    }
+}
+
+/// [`DirectionSample`] per lane, with where each lane's is one (`valid`: the invariant
+/// holds); elsewhere the values are meaningless.
+#[derive(Clone, Copy, Debug)]
+pub struct DirectionSampleLanes<L: Lane> {
+    /// Unit direction from each shading point toward its `point`.
+    pub wi: LaneVec3<L>,
+    /// Distance from each shading point to its `point`.
+    pub distance: L,
+    /// Density of `wi` with respect to solid angle.
+    pub pdf: L,
+    /// The sampled points on the light.
+    pub point: LaneVec3<L>,
+    /// The light's unit normals at `point`.
+    pub normal: LaneVec3<L>,
+    /// Where the lane holds a sample.
+    pub valid: L::Mask,
+}
+
+impl<L: Lane> DirectionSampleLanes<L> {
+    /// [`DirectionSample::toward_with`] per lane: the sample from `p` toward `point`, where
+    /// the routine's pdf there is `pdf` and it has one where `has_pdf`. (Values, not a
+    /// closure as the scalar form takes: a vector kernel inlines only what is marked to
+    /// be inlined.)
+    #[inline(always)]
+    pub(crate) fn toward(
+        p: LaneVec3<L>,
+        (point, normal): (LaneVec3<L>, LaneVec3<L>),
+        (wi, distance, toward): (LaneVec3<L>, L, L::Mask),
+        (pdf, has_pdf): (L, L::Mask),
+    ) -> Self {
+        let zero = L::splat(0.0);
+        // `DirectionSample::is_valid`, and the inputs' finiteness, which the scalar
+        // routines check first.
+        let valid = L::and(
+            L::and(L::and(toward, has_pdf), finite3_lanes(p)),
+            L::and(
+                L::and(finite_lanes(pdf), pdf.gt(zero)),
+                L::and(
+                    L::and(finite_lanes(distance), distance.gt(zero)),
+                    L::and(finite3_lanes(point), finite3_lanes(normal)),
+                ),
+            ),
+        );
+        Self {
+            wi,
+            distance,
+            pdf,
+            point,
+            normal,
+            valid,
+        }
+    }
+}
+
+impl DirectionSampleLanes<f32> {
+    /// The one lane's sample, `None` where it has none.
+    #[inline]
+    pub fn single(self) -> Option<DirectionSample> {
+        self.valid.then(|| DirectionSample {
+            wi: self.wi.into(),
+            distance: self.distance,
+            pdf: self.pdf,
+            point: self.point.into(),
+            normal: self.normal.into(),
+        })
     }
 }

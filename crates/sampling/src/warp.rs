@@ -6,7 +6,11 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
 use glam::{Vec2, Vec3};
 
-use crate::math::{ONE_MINUS_EPSILON, clamp_u, clamp_u2, safe_sqrt};
+use lueur_sdf_math::{Lane, LaneVec3};
+
+use crate::math::{
+    ONE_MINUS_EPSILON, clamp_u, clamp_u_lanes, clamp_u2, safe_sqrt, safe_sqrt_lanes, sin_cos_turns,
+};
 
 /// Azimuth of `(x, y)` in `[0, 2pi)`.
 #[inline]
@@ -117,11 +121,17 @@ pub fn invert_cosine_hemisphere(w: Vec3) -> Vec2 {
 /// Uniform direction on the unit sphere (pbrt-v4 §A.5.2):
 /// `z = 1 - 2 u0`, `phi = 2pi u1`.
 pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
-    let u = clamp_u2(u);
-    let z = 1.0 - 2.0 * u.x;
-    let r = safe_sqrt(1.0 - z * z);
-    let phi = TAU * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    sample_uniform_sphere_lanes([u.x, u.y]).into()
+}
+
+/// [`sample_uniform_sphere`] per lane, its one definition.
+#[inline(always)]
+pub(crate) fn sample_uniform_sphere_lanes<L: Lane>([u0, u1]: [L; 2]) -> LaneVec3<L> {
+    let one = L::splat(1.0);
+    let z = one - L::splat(2.0) * clamp_u_lanes(u0);
+    let r = safe_sqrt_lanes(one - z * z);
+    let (sin, cos) = sin_cos_turns(clamp_u_lanes(u1));
+    LaneVec3::new(r * cos, r * sin, z)
 }
 
 /// Solid-angle pdf of [`sample_uniform_sphere`]: `1 / 4pi` (pbrt-v4 §A.5.2).

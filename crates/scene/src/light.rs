@@ -185,13 +185,39 @@ impl Light {
     /// solid-angle pdf; `None` where the sample has no weight (a back face,
     /// a delta light).
     pub fn sample(&self, p: Vec3, u: Vec2, quad_sampling: QuadSampling) -> Option<EmitterSample> {
+        self.sample_drawn(p, u, quad_sampling, None)
+    }
+
+    /// A sphere light's centre and radius: what a renderer needs to draw its direction
+    /// samples in batches ([`lueur_sampling::sample_sphere_light_lanes`]).
+    pub fn as_sphere(&self) -> Option<(Vec3, f32)> {
+        match *self {
+            Light::Sphere { center, radius, .. } => Some((center, radius)),
+            Light::Quad { .. } | Light::Directional { .. } => None,
+        }
+    }
+
+    /// [`Light::sample`], where a sphere light's direction sample may have been `drawn`
+    /// already, by [`lueur_sampling::sample_sphere_light`] or its batch form, from `p`
+    /// with `u` (`None`: draw it here; other lights always draw their own).
+    #[inline]
+    pub fn sample_drawn(
+        &self,
+        p: Vec3,
+        u: Vec2,
+        quad_sampling: QuadSampling,
+        drawn: Option<Option<DirectionSample>>,
+    ) -> Option<EmitterSample> {
         let (s, radiance): (DirectionSample, Vec3) = match *self {
             Light::Sphere {
                 center,
                 radius,
                 radiance,
             } => {
-                let s = sample_sphere_light(p, center, radius, u)?;
+                let s = match drawn {
+                    Some(s) => s?,
+                    None => sample_sphere_light(p, center, radius, u)?,
+                };
                 // Only the outward face emits.
                 if s.normal.dot(s.wi) >= 0.0 {
                     return None;
