@@ -202,7 +202,11 @@ impl LaneKernel for Clip<'_> {
             let mut seen = L::splat(0.0).gt(L::splat(0.0));
             for (k, entry) in geometry.order.iter().enumerate() {
                 let (t0, t1, keep) = match &entry.bound {
-                    ObjectBound::Box { aabb, .. } => clip.clip_box_lanes(aabb),
+                    ObjectBound::Box { aabb, .. } => match clip.clip_box_lanes_in(aabb, live) {
+                        Some(clip) => clip,
+                        // No ray of the group keeps the object.
+                        None => continue,
+                    },
                     ObjectBound::HalfSpace(h) => clip.clip_half_space_lanes(h),
                     ObjectBound::Everywhere => (t_min, t_max, L::splat(0.0).lt(L::splat(1.0))),
                 };
