@@ -220,8 +220,10 @@ fn shade(
 /// drawn from `samplers[i]`), estimated by one path each, into `out` (cleared first).
 ///
 /// The paths advance together, a vertex at a time: their rays are traced as one stream,
-/// then each is shaded, then their shadow rays are traced as another stream, then each
-/// gathers what its shadow rays bring and scatters. Every path does exactly what it
+/// then each draws its vertex's numbers, the sphere-light samples its next-event
+/// estimation chose are drawn as one batch, then each is shaded, then their shadow rays
+/// are traced as another stream, then each gathers what its shadow rays bring and
+/// scatters. Every path does exactly what it
 /// would do alone (the stages are functions of the path's own inputs, and each path adds
 /// to its estimate in the same order), so an estimate does not depend on which paths
 /// share its wave, nor on the instruction set the streams run on.
