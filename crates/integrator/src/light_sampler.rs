@@ -225,6 +225,9 @@ impl SphereDraws {
     /// Draws every request's sample on `level` (the widest available where it is not).
     pub fn draw(&mut self, level: SimdLevel) {
         self.drawn.clear();
+        if self.requests.is_empty() {
+            return;
+        }
         // The level is available: `or_widest` says so.
         let _ = level.or_widest().dispatch(DrawSpheres {
             requests: &self.requests,

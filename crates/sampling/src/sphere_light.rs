@@ -99,11 +99,11 @@ pub fn sample_sphere_light(p: Vec3, center: Vec3, radius: f32, u: Vec2) -> Optio
 }
 
 /// [`sample_sphere_light`] for a shading point and a sphere per lane (`u` the two
-/// numbers of each),
-/// its one definition: each lane is, bit for bit, what the scalar function gives for
-/// that lane's inputs, valid where it gives `Some`. Both sides of the sphere are
-/// computed for every lane and the side each lane is on is kept, so that a vector of
-/// shading points costs about what one does.
+/// numbers of each), its one definition: each lane is, bit for bit, what the scalar
+/// function gives for that lane's inputs, valid where it gives `Some`. The outside
+/// cone is computed for every lane, the inside sample where any lane is inside, and
+/// each lane keeps its side, so that a vector of shading points costs about what one
+/// does.
 #[inline(always)]
 pub fn sample_sphere_light_lanes<L: Lane>(
     p: LaneVec3<L>,
