@@ -54,6 +54,11 @@ impl DiscreteDistribution {
     /// Draws an index from a uniform `u` in `[0, 1)` and returns it with its
     /// pmf. Never returns an index of pmf 0.
     pub fn sample(&self, u: f32) -> (usize, f32) {
+        // One index (a scene with one light): what the search below finds for every `u`,
+        // without it; the renderer asks once or twice per path vertex.
+        if let [pmf] = self.pmf[..] {
+            return (0, pmf);
+        }
         let u = f64::from(clamp_u(u));
         // First i with cdf[i + 1] > u; cdf[len] = 1 > u, so i < len.
         let i = self.cdf[1..].partition_point(|&c| c <= u);
@@ -81,6 +86,21 @@ impl DiscreteDistribution {
 mod tests {
     use super::*;
     use crate::math::ONE_MINUS_EPSILON;
+
+    /// One index: index 0 with pmf 1 for every `u`, as the search finds it (the shortcut
+    /// must not change a draw).
+    #[test]
+    fn one_index_is_always_drawn_with_pmf_one() {
+        for d in [
+            DiscreteDistribution::uniform(1).unwrap(),
+            DiscreteDistribution::new(&[3.5]).unwrap(),
+        ] {
+            for u in [0.0, 0.5, ONE_MINUS_EPSILON, 1.0, -1.0, f32::NAN] {
+                assert_eq!(d.sample(u), (0, 1.0), "u = {u}");
+            }
+            assert_eq!(d.pmf(0), 1.0);
+        }
+    }
 
     #[test]
     fn rejects_bad_weights() {
