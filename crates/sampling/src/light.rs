@@ -3,7 +3,7 @@
 use glam::Vec3;
 use lueur_sdf_math::{Lane, LaneVec3};
 
-use crate::math::{finite_lanes, finite3_lanes, normalize_with_length};
+use crate::math::normalize_with_length;
 
 /// A direction sampled toward a light from a shading point `p`, with its
 /// solid-angle pdf.
@@ -89,12 +89,12 @@ impl<L: Lane> DirectionSampleLanes<L> {
         // `DirectionSample::is_valid`, and the inputs' finiteness, which the scalar
         // routines check first.
         let valid = L::and(
-            L::and(L::and(toward, has_pdf), finite3_lanes(p)),
+            L::and(L::and(toward, has_pdf), p.finite()),
             L::and(
-                L::and(finite_lanes(pdf), pdf.gt(zero)),
+                L::and(pdf.finite(), pdf.gt(zero)),
                 L::and(
-                    L::and(finite_lanes(distance), distance.gt(zero)),
-                    L::and(finite3_lanes(point), finite3_lanes(normal)),
+                    L::and(distance.finite(), distance.gt(zero)),
+                    L::and(point.finite(), normal.finite()),
                 ),
             ),
         );

@@ -55,21 +55,6 @@ pub(crate) fn safe_sqrt_lanes<L: Lane>(x: L) -> L {
     x.max(L::splat(0.0)).sqrt()
 }
 
-/// Where `x` is finite: zero times an infinity or a NaN is NaN, which no comparison holds.
-#[inline(always)]
-pub(crate) fn finite_lanes<L: Lane>(x: L) -> L::Mask {
-    (x * L::splat(0.0)).ge(L::splat(0.0))
-}
-
-/// Where every coordinate of `v` is finite.
-#[inline(always)]
-pub(crate) fn finite3_lanes<L: Lane>(v: LaneVec3<L>) -> L::Mask {
-    L::and(
-        finite_lanes(v.x),
-        L::and(finite_lanes(v.y), finite_lanes(v.z)),
-    )
-}
-
 /// [`normalize_with_length`] per lane: the unit vector, the length, and where they are
 /// valid (elsewhere the values are meaningless).
 #[inline(always)]
@@ -77,8 +62,8 @@ pub(crate) fn normalize_with_length_lanes<L: Lane>(v: LaneVec3<L>) -> (LaneVec3<
     let length = v.length();
     let unit = v / length;
     let valid = L::and(
-        L::and(finite_lanes(length), length.gt(L::splat(f32::MIN_POSITIVE))),
-        finite3_lanes(unit),
+        L::and(length.finite(), length.gt(L::splat(f32::MIN_POSITIVE))),
+        unit.finite(),
     );
     (unit, length, valid)
 }

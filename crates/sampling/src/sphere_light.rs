@@ -14,10 +14,7 @@ use lueur_sdf_math::{Lane, LaneVec3};
 
 use crate::frame::FrameLanes;
 use crate::light::{DirectionSample, DirectionSampleLanes};
-use crate::math::{
-    clamp_u_lanes, finite_lanes, finite3_lanes, normalize_with_length_lanes, safe_sqrt_lanes,
-    sin_cos_turns,
-};
+use crate::math::{clamp_u_lanes, normalize_with_length_lanes, safe_sqrt_lanes, sin_cos_turns};
 use crate::warp::sample_uniform_sphere_lanes;
 
 /// True when `p` is inside or on the sphere; the sampler and the pdf must
@@ -113,8 +110,8 @@ pub fn sample_sphere_light_lanes<L: Lane>(
 ) -> DirectionSampleLanes<L> {
     let one = L::splat(1.0);
     let valid_sphere = L::and(
-        L::and(finite_lanes(radius), radius.gt(L::splat(0.0))),
-        finite3_lanes(center),
+        L::and(radius.finite(), radius.gt(L::splat(0.0))),
+        center.finite(),
     );
     let inside = is_inside(p, center, radius);
     // Inside or on: a uniform point on the sphere, where some lane needs it (a shading

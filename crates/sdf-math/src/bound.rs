@@ -294,15 +294,6 @@ impl<L: Lane> RayClipLanes<L> {
         let zero = L::splat(0.0);
         let eps_rel = eps_rel.max(zero);
         let rel = LaneVec3::new(eps_rel, eps_rel, eps_rel);
-        #[inline(always)]
-        fn finite<L: Lane>(v: L) -> L::Mask {
-            // Zero times infinity is NaN, as is zero times NaN.
-            (v * L::splat(0.0)).ge(L::splat(0.0))
-        }
-        #[inline(always)]
-        fn all_finite<L: Lane>(v: LaneVec3<L>) -> L::Mask {
-            L::and(finite(v.x), L::and(finite(v.y), finite(v.z)))
-        }
         RayClipLanes {
             origin,
             dir,
@@ -312,7 +303,7 @@ impl<L: Lane> RayClipLanes<L> {
                 Slope::new(-dir),
                 Slope::new(-dir - rel),
             ],
-            degenerate: L::not(L::and(all_finite(origin), all_finite(dir))),
+            degenerate: L::not(L::and(origin.finite(), dir.finite())),
             eps_abs: eps_abs.max(zero),
             eps_rel,
             t_min,

@@ -82,6 +82,13 @@ pub trait Lane:
     fn bits(mask: Self::Mask) -> u32;
     /// `if mask { if_true } else { if_false }`, per lane.
     fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
+
+    /// Where the lane is finite: zero times an infinity or a NaN is NaN, which no
+    /// comparison holds.
+    #[inline(always)]
+    fn finite(self) -> Self::Mask {
+        (self * Self::splat(0.0)).ge(Self::splat(0.0))
+    }
 }
 
 /// Work handed to [`Isa::within`]: a struct, not a closure, because

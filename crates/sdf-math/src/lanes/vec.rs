@@ -89,6 +89,12 @@ impl<L: Lane> LaneVec3<L> {
         self.x.max_cmp(self.y.max_cmp(self.z))
     }
 
+    /// Where every coordinate is finite ([`Lane::finite`]).
+    #[inline(always)]
+    pub fn finite(self) -> L::Mask {
+        L::and(self.x.finite(), L::and(self.y.finite(), self.z.finite()))
+    }
+
     /// glam's `cross`.
     #[inline(always)]
     pub fn cross(self, rhs: Self) -> Self {
