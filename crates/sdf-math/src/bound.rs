@@ -93,7 +93,8 @@ impl Aabb {
 
     /// The part of `[params.t_min, params.t_max]` where a field honouring this box (at
     /// least the distance to the box, outside it) can fall below the tracer's hit
-    /// threshold `max(eps_abs, eps_rel t)`; `None` where there is no such part. See
+    /// threshold `max(eps_abs, eps_rel t)`, as the box grown by `eps_abs + eps_rel t`
+    /// gives it (at most one threshold too wide); `None` where there is no such part. See
     /// [`RayClip::clip_box`]; when clipping one ray against many boxes, make the
     /// [`RayClip`] once.
     pub fn hit_interval(&self, ray: &Ray, params: &TraceParams) -> Option<(f32, f32)> {
@@ -109,11 +110,14 @@ impl Aabb {
 /// planes (`dot(p, n) - h`, with unit `n` for a box). Along the ray each of those is
 /// linear in `t`, `a + b t`, and it can be below the hit threshold `max(eps_abs,
 /// eps_rel t)` only on `{a - eps_abs + b t < 0} ∪ {a + (b - eps_rel) t < 0}`: two
-/// half-lines, solved exactly. A hit is possible only where every plane allows it, so the
-/// interval is the intersection over the planes of each one's hull. No square root, no
-/// margin guessed from the ray's length: a ray leaving a wall is never a candidate for
-/// that wall (the plane it leaves grows faster than `eps_rel t`), however close it
-/// starts.
+/// half-lines. A hit is possible only where every plane allows it, so the interval is
+/// the intersection over the planes of those sets. A half-space's one plane takes the two
+/// half-lines exactly. A box's six take, each, the one half-line `{a - eps_abs + (b -
+/// eps_rel) t < 0}` that holds both (the threshold is at most `eps_abs + eps_rel t`): a
+/// set wider by at most one threshold, for half the work of the clip, which every ray
+/// does against every box. No square root, no margin guessed from the ray's length: a ray
+/// leaving a wall is never a candidate for that wall (the plane it leaves grows faster
+/// than `eps_rel t`), however close it starts.
 ///
 /// Written once over [`Lane`]s, a ray per lane ([`RayClipLanes`]); [`RayClip`] is the
 /// one-ray case, and every lane of a vector gives that ray's bits.
@@ -121,11 +125,11 @@ impl Aabb {
 pub struct RayClipLanes<L: Lane> {
     origin: LaneVec3<L>,
     dir: LaneVec3<L>,
-    /// The four families of box planes, per axis: faces facing + (value `o - max`, slope
-    /// `d`) and facing - (value `min - o`, slope `-d`), each against the absolute and the
-    /// relative threshold (slope less `eps_rel`). Slopes are per ray, so their reciprocals
-    /// and signs are too.
-    families: [Slope<L>; 4],
+    /// The two families of box planes, per axis: faces facing + (value `o - max`, slope
+    /// `d`) and facing - (value `min - o`, slope `-d`), each against the sum of the
+    /// thresholds (slope less `eps_rel`). Slopes are per ray, so their reciprocals and
+    /// signs are too.
+    families: [Slope<L>; 2],
     /// A non-finite origin or direction: every clip keeps the whole range.
     degenerate: L::Mask,
     eps_abs: L,
@@ -297,12 +301,7 @@ impl<L: Lane> RayClipLanes<L> {
         RayClipLanes {
             origin,
             dir,
-            families: [
-                Slope::new(dir),
-                Slope::new(dir - rel),
-                Slope::new(-dir),
-                Slope::new(-dir - rel),
-            ],
+            families: [Slope::new(dir - rel), Slope::new(-dir - rel)],
             degenerate: L::not(L::and(origin.finite(), dir.finite())),
             eps_abs: eps_abs.max(zero),
             eps_rel,
@@ -343,8 +342,8 @@ impl<L: Lane> RayClipLanes<L> {
         // only what is marked to be inlined.
         #[inline(always)]
         fn axis<L: Lane>(clip: &RayClipLanes<L>, aabb: &Aabb, axis: usize) -> (L, L) {
-            let [up_abs, up_rel, down_abs, down_rel] = &clip.families;
-            let (t_min, t_max, eps_abs) = (clip.t_min, clip.t_max, clip.eps_abs);
+            let [up, down] = &clip.families;
+            let (t_min, t_max) = (clip.t_min, clip.t_max);
             let o = component(clip.origin, axis);
             let (min, max) = (L::splat(aabb.min[axis]), L::splat(aabb.max[axis]));
             // Taken off every plane value: the f32 rounding of the numbers that decide it,
@@ -352,18 +351,10 @@ impl<L: Lane> RayClipLanes<L> {
             // axis, not the largest coordinate of all, so that a ray leaving the top of a
             // floor 1e4 wide is not a candidate for it however close above it starts.
             let scale = o.abs().max_cmp(min.abs()).max_cmp(max.abs());
-            let rounding = L::splat(4.0 * f32::EPSILON) * scale;
-            let up = o - max - rounding;
-            let down = min - o - rounding;
-            let (lo_a, hi_a) = up_abs.below(axis, up - eps_abs, t_min, t_max);
-            let (lo_b, hi_b) = up_rel.below(axis, up, t_min, t_max);
-            let (lo_c, hi_c) = down_abs.below(axis, down - eps_abs, t_min, t_max);
-            let (lo_d, hi_d) = down_rel.below(axis, down, t_min, t_max);
-            // Per face the hull of its two sets; over the faces, the intersection.
-            (
-                lo_a.min_cmp(lo_b).max_cmp(lo_c.min_cmp(lo_d)),
-                hi_a.max_cmp(hi_b).min_cmp(hi_c.max_cmp(hi_d)),
-            )
+            let slack = L::splat(4.0 * f32::EPSILON) * scale + clip.eps_abs;
+            let (lo_up, hi_up) = up.below(axis, o - max - slack, t_min, t_max);
+            let (lo_down, hi_down) = down.below(axis, min - o - slack, t_min, t_max);
+            (lo_up.max_cmp(lo_down), hi_up.min_cmp(hi_down))
         }
         // Over the axes, as `max_element` and `min_element` take them: `x` with `(y, z)`.
         let (lo_z, hi_z) = axis(self, aabb, 2);

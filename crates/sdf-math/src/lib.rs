@@ -9,8 +9,8 @@
 //! place; the operators and transforms delegate to them and never name one.
 //!
 //! Around the tree: bounds a tracer can clip rays against before marching them
-//! ([`Sdf::bounding_box`], [`Sdf::bounding_half_space`], with [`RayClip`] giving the exact
-//! range of a ray where a hit is possible), and [`PreparedSdf`], the same field with its
+//! ([`Sdf::bounding_box`], [`Sdf::bounding_half_space`], with [`RayClip`] giving the
+//! range of a ray where a hit is possible, without square roots), and [`PreparedSdf`], the same field with its
 //! transforms folded into one affine map for hot loops.
 //!
 //! Contract: **every `Sdf` is Lipschitz with the bound it reports**,
