@@ -18,6 +18,10 @@ use crate::{DistanceField, Sdf};
 #[derive(Clone, Debug, PartialEq)]
 pub struct PreparedSdf {
     to_local: Affine3A,
+    /// Whether the map only moves (its matrix is the identity): the common object of a
+    /// scene file, whose frame is then `p + translation`, three additions instead of nine
+    /// products and nine sums.
+    moved_only: bool,
     factor: f32,
     shape: Sdf,
     lipschitz: f32,
@@ -51,6 +55,7 @@ impl PreparedSdf {
         }
         PreparedSdf {
             to_local,
+            moved_only: to_local.matrix3 == Mat3A::IDENTITY,
             factor,
             shape: node.clone(),
             lipschitz: sdf.lipschitz(),
@@ -84,7 +89,7 @@ impl PreparedSdf {
     #[inline(always)]
     pub fn evaluation_scale_lanes<L: Lane>(&self, p: LaneVec3<L>) -> L {
         let own = L::splat(self.factor) * self.local(p).abs().max_element();
-        if self.to_local.matrix3 == Mat3A::IDENTITY {
+        if self.moved_only {
             own
         } else {
             own.max(p.abs().max_element())
@@ -93,12 +98,20 @@ impl PreparedSdf {
 }
 
 impl PreparedSdf {
-    /// `p` in the shape's frame: glam's `Affine3A::transform_point3a` written out in its
-    /// order, `((X p.x + Y p.y) + Z p.z) + T` with the matrix's columns `X`, `Y`, `Z`.
+    /// `p` in the shape's frame: `p + T` for a map that only moves, else glam's
+    /// `Affine3A::transform_point3a` written out in its order, `((X p.x + Y p.y) + Z p.z)
+    /// + T` with the matrix's columns `X`, `Y`, `Z`.
     #[inline(always)]
     fn local<L: Lane>(&self, p: LaneVec3<L>) -> LaneVec3<L> {
         let m = &self.to_local.matrix3;
         let t = self.to_local.translation;
+        if self.moved_only {
+            return LaneVec3::new(
+                p.x + L::splat(t.x),
+                p.y + L::splat(t.y),
+                p.z + L::splat(t.z),
+            );
+        }
         LaneVec3::new(
             affine_coordinate(p, Vec3::new(m.x_axis.x, m.y_axis.x, m.z_axis.x), t.x),
             affine_coordinate(p, Vec3::new(m.x_axis.y, m.y_axis.y, m.z_axis.y), t.y),
