@@ -100,8 +100,9 @@ pub(crate) struct MarchBatch {
     /// at its last evaluation.
     outcomes: Vec<TraceOutcome>,
     nearest: Vec<u32>,
-    /// Per lane and position in the order, while clipping: the lane's candidates.
-    clipped: Vec<u32>,
+    /// While clipping, per group of [`OBJECTS_PER_MASK`] positions in the order, the
+    /// candidates of each lane among them: position `j` of the group as `2^j`, summed.
+    kept: Vec<[f32; MAX_LANES]>,
     /// While marching, [`CandidateLanes`]'s `member` and `members`.
     member: Vec<[f32; MAX_LANES]>,
     members: Vec<u32>,
@@ -145,6 +146,10 @@ impl MarchBatch {
     }
 }
 
+/// Objects per row of [`MarchBatch::kept`]: sums of distinct powers of two are exact in
+/// `f32` below `2^24`.
+const OBJECTS_PER_MASK: usize = 24;
+
 /// The kernel that clips the queued rays of a [`MarchBatch`] against every object's bound,
 /// a ray per lane, and keeps each ray's candidates and the range they cover.
 struct Clip<'a> {
@@ -159,11 +164,11 @@ impl LaneKernel for Clip<'_> {
     fn run<L: Lane>(self) {
         let Clip { geometry, batch } = self;
         let lanes = L::LANES.min(MAX_LANES);
-        let objects = geometry.order.len();
-        let mut clipped = std::mem::take(&mut batch.clipped);
-        // A slot past each lane's last, for the write of an object it does not keep.
-        let stride = objects + 1;
-        clipped.resize(lanes * stride, 0);
+        let mut kept_rows = std::mem::take(&mut batch.kept);
+        kept_rows.resize(
+            geometry.order.len().div_ceil(OBJECTS_PER_MASK),
+            [0.0; MAX_LANES],
+        );
         let mut start = 0;
         // Kept across groups: lanes past a short last group hold an earlier ray, finite
         // and never read (`live`).
@@ -197,29 +202,31 @@ impl LaneKernel for Clip<'_> {
             // `seen`: the first kept object's interval, then each one's union with it,
             // as `f32::min` and `f32::max` take it), and the candidates kept, in order.
             let live = u32::MAX >> (32 - group.len());
-            let mut count = [0usize; MAX_LANES];
             let (mut lo, mut hi) = (L::splat(0.0), L::splat(0.0));
             let mut seen = L::splat(0.0).gt(L::splat(0.0));
-            for (k, entry) in geometry.order.iter().enumerate() {
-                let (t0, t1, keep) = match &entry.bound {
-                    ObjectBound::Box { aabb, .. } => match clip.clip_box_lanes_in(aabb, live) {
-                        Some(clip) => clip,
-                        // No ray of the group keeps the object.
-                        None => continue,
-                    },
-                    ObjectBound::HalfSpace(h) => clip.clip_half_space_lanes(h),
-                    ObjectBound::Everywhere => (t_min, t_max, L::splat(0.0).lt(L::splat(1.0))),
-                };
-                lo = L::select(keep, L::select(seen, lo.min(t0), t0), lo);
-                hi = L::select(keep, L::select(seen, hi.max(t1), t1), hi);
-                seen = L::or(seen, keep);
-                // Every lane writes, and only the lanes that keep the object advance: no
-                // branch on the mask, whose bits are as random as the rays.
-                let kept = L::bits(keep) & live;
-                for (lane, count) in count.iter_mut().enumerate().take(lanes) {
-                    clipped[lane * stride + *count] = k as u32;
-                    *count += (kept >> lane & 1) as usize;
+            let chunks = geometry.order.chunks(OBJECTS_PER_MASK);
+            for (entries, row) in chunks.zip(kept_rows.iter_mut()) {
+                // Each lane's candidates among these objects, in two vector operations per
+                // object: no per-lane work, whose branches would be as random as the rays.
+                let mut kept = L::splat(0.0);
+                for (j, entry) in entries.iter().enumerate() {
+                    let (t0, t1, keep) = match &entry.bound {
+                        ObjectBound::Box { aabb, .. } => {
+                            match clip.clip_box_lanes_in(aabb, live) {
+                                Some(clip) => clip,
+                                // No ray of the group keeps the object.
+                                None => continue,
+                            }
+                        }
+                        ObjectBound::HalfSpace(h) => clip.clip_half_space_lanes(h),
+                        ObjectBound::Everywhere => (t_min, t_max, L::splat(0.0).lt(L::splat(1.0))),
+                    };
+                    lo = L::select(keep, L::select(seen, lo.min(t0), t0), lo);
+                    hi = L::select(keep, L::select(seen, hi.max(t1), t1), hi);
+                    seen = L::or(seen, keep);
+                    kept = L::select(keep, kept + L::splat((1u32 << j) as f32), kept);
                 }
+                kept.store(&mut row[..lanes]);
             }
             let (mut los, mut his) = ([0f32; MAX_LANES], [0f32; MAX_LANES]);
             lo.store(&mut los[..lanes]);
@@ -232,8 +239,14 @@ impl LaneKernel for Clip<'_> {
                 }
                 let (t_min, t_max) = (los[lane], his[lane]);
                 let first = batch.candidates.len() as u32;
-                let own = &clipped[lane * stride..lane * stride + count[lane]];
-                batch.candidates.extend_from_slice(own);
+                for (chunk, row) in kept_rows.iter().enumerate() {
+                    let base = (chunk * OBJECTS_PER_MASK) as u32;
+                    let mut kept = row[lane] as u32;
+                    while kept != 0 {
+                        batch.candidates.push(base + kept.trailing_zeros());
+                        kept &= kept - 1;
+                    }
+                }
                 batch.spans.push((first, batch.candidates.len() as u32));
                 batch.rays.push(ray);
                 batch.params.push(TraceParams {
@@ -244,7 +257,7 @@ impl LaneKernel for Clip<'_> {
                 batch.tags.push(tag);
             }
         }
-        batch.clipped = clipped;
+        batch.kept = kept_rows;
     }
 }
 
