@@ -233,8 +233,12 @@ pub fn render_pass_in(
             )
         })?;
     let sink = film.pass_sink(&plan, TILE);
+    // One tile per job: rayon's adaptive split would otherwise hand each thread runs of
+    // up to a quarter of the tiles as one job it cannot share, and a pass would end with a
+    // thread idle for several tiles (docs/PERFORMANCE.md, "The progressive passes").
     let results: Vec<Option<TileCost>> = tiles
         .par_iter()
+        .with_max_len(1)
         .map(|&origin| {
             let r = render_tile(&estimator, bounds, origin, plan.pass_blocks(), cancel)?;
             // Checked again so that no tile commits after the signal has
