@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use lueur_sdf_math::{
-    Aabb, DistanceField, HalfSpace, Lane, LaneDistance, LaneKernel, LaneVec3, MAX_LANES,
+    Aabb, BoundingSphere, DistanceField, HalfSpace, Lane, LaneDistance, LaneKernel, LaneVec3, MAX_LANES,
     OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClipLanes, Sdf, SimdLevel, StreamField,
     TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed_stream_of, write_lane,
 };
@@ -49,8 +49,12 @@ struct Ordered {
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum ObjectBound {
     /// The object's bounding box; `cull` when checking the box is cheaper than evaluating
-    /// the object (not for boxes and spheres, whose box check costs as much as they do).
+    /// the object (not for boxes, whose box check costs as much as they do).
     Box { aabb: Aabb, cull: bool },
+    /// A sphere's own sphere: its box holds the rays that pass near its silhouette, and
+    /// those are the long marches (docs/PERFORMANCE.md, "Spheres clipped by their
+    /// sphere").
+    Sphere(BoundingSphere),
     /// Planes and what is cut from them.
     HalfSpace(HalfSpace),
     /// Nothing known: the object takes part in every march.
@@ -59,7 +63,9 @@ enum ObjectBound {
 
 impl ObjectBound {
     fn of(sdf: &Sdf) -> ObjectBound {
-        if let Some(aabb) = sdf.bounding_box() {
+        if let (true, Some((center, radius))) = (is_sphere(sdf), sdf.bounding_sphere()) {
+            ObjectBound::Sphere(BoundingSphere { center, radius })
+        } else if let Some(aabb) = sdf.bounding_box() {
             let cull = !is_sphere(sdf) && !is_box(sdf);
             ObjectBound::Box { aabb, cull }
         } else if let Some(h) = sdf.bounding_half_space() {
@@ -218,6 +224,7 @@ impl LaneKernel for Clip<'_> {
                                 None => continue,
                             }
                         }
+                        ObjectBound::Sphere(sphere) => clip.clip_sphere_lanes(sphere),
                         ObjectBound::HalfSpace(h) => clip.clip_half_space_lanes(h),
                         ObjectBound::Everywhere => (t_min, t_max, L::splat(0.0).lt(L::splat(1.0))),
                     };

@@ -1,15 +1,17 @@
 //! Bounds a ray can be clipped against before it is marched: an axis-aligned box (for
-//! bounded shapes) and a half-space (for planes and what is cut from them).
+//! bounded shapes), a sphere (for spheres, whose box is loose) and a half-space (for
+//! planes and what is cut from them).
 //!
 //! A bound is only useful with its contract, stronger than containment: the shape's
 //! *field* never undercuts the distance to the bound ([`Sdf::bounding_box`],
-//! [`Sdf::bounding_half_space`]). Then the parameters along a ray where a tracer could
-//! declare a hit on the shape (field below `max(eps_abs, eps_rel t)`) lie inside the
-//! interval [`Aabb::hit_interval`] or [`HalfSpace::hit_interval`] returns, and a tracer
-//! may ignore the shape outside it, or altogether when it is empty, without changing
-//! which surface the ray finds.
+//! [`Sdf::bounding_sphere`], [`Sdf::bounding_half_space`]). Then the parameters along a
+//! ray where a tracer could declare a hit on the shape (field below `max(eps_abs, eps_rel
+//! t)`) lie inside the interval [`Aabb::hit_interval`], [`BoundingSphere::hit_interval`] or
+//! [`HalfSpace::hit_interval`] returns, and a tracer may ignore the shape outside it, or
+//! altogether when it is empty, without changing which surface the ray finds.
 //!
 //! [`Sdf::bounding_box`]: crate::Sdf::bounding_box
+//! [`Sdf::bounding_sphere`]: crate::Sdf::bounding_sphere
 //! [`Sdf::bounding_half_space`]: crate::Sdf::bounding_half_space
 
 use glam::Vec3;
@@ -258,6 +260,26 @@ fn widen<L: Lane>(t0: L, t1: L, t_min: L, t_max: L) -> (L, L, L::Mask) {
     )
 }
 
+/// A ball `|p - center| <= radius`, as [`Sdf::bounding_sphere`](crate::Sdf::bounding_sphere)
+/// gives it: the field is at least `|p - center| - radius`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoundingSphere {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius (at least 0).
+    pub radius: f32,
+}
+
+impl BoundingSphere {
+    /// The part of `[params.t_min, params.t_max]` where a field honouring this sphere can
+    /// fall below the hit threshold `max(eps_abs, eps_rel t)`: where the ray is within
+    /// `radius + eps_abs + eps_rel t` of the centre, and some rounding more; `None` where
+    /// there is no such part. See [`RayClip::clip_sphere`].
+    pub fn hit_interval(&self, ray: &Ray, params: &TraceParams) -> Option<(f32, f32)> {
+        RayClip::new(ray, params).clip_sphere(self)
+    }
+}
+
 impl RayClip {
     /// Prepares `ray` for clipping with the hit thresholds and range of `params`.
     #[inline]
@@ -274,6 +296,16 @@ impl RayClip {
     #[inline]
     pub fn clip_box(&self, aabb: &Aabb) -> Option<(f32, f32)> {
         let (t0, t1, kept) = self.clip_box_lanes(aabb);
+        kept.then_some((t0, t1))
+    }
+
+    /// [`BoundingSphere::hit_interval`] for this ray: the ray within the sphere grown by
+    /// the threshold, a quadratic in `t` solved about the ray's closest approach to the
+    /// centre (see [`RayClipLanes::clip_sphere_lanes`]), its ends widened by a relative
+    /// `1e-5`.
+    #[inline]
+    pub fn clip_sphere(&self, sphere: &BoundingSphere) -> Option<(f32, f32)> {
+        let (t0, t1, kept) = self.clip_sphere_lanes(sphere);
         kept.then_some((t0, t1))
     }
 
@@ -375,6 +407,55 @@ impl<L: Lane> RayClipLanes<L> {
             L::select(self.degenerate, t_max, t1),
             L::or(self.degenerate, kept),
         ))
+    }
+
+    /// [`RayClip::clip_sphere`] for each lane's ray, as [`RayClipLanes::clip_box_lanes`].
+    ///
+    /// A hit at `t` needs `|m + t d| < R(t)`, with `m` the origin less the centre and
+    /// `R(t) = R0 + eps_rel t`, `R0` the radius grown by `eps_abs` and the rounding slack
+    /// (the threshold `max(eps_abs, eps_rel t)` is at most `eps_abs + eps_rel t`). About
+    /// the closest approach `t_c = -(m . d) / (d . d)`, with `q = m + t_c d` (orthogonal
+    /// to `d`) and `u = t - t_c`, that is `q . q + u^2 (d . d) < (A + eps_rel u)^2` with
+    /// `A = R0 + eps_rel t_c`: a quadratic in `u` whose discriminant (over four) is `A^2
+    /// (d . d) - (d . d - eps_rel^2) (q . q)`. Solved about `t_c` rather than from the
+    /// origin, as Haines et al. advise ("Precise Ray/Sphere Intersection", Ray Tracing
+    /// Gems, ch. 7): `q` is computed, not found as a difference of two large squares, so a
+    /// millimetre sphere a kilometre away is still told from a miss. Where `d . d` is not
+    /// above `eps_rel^2` (a threshold growing as fast as the ray), every lane keeps the
+    /// whole range.
+    #[inline(always)]
+    pub fn clip_sphere_lanes(&self, sphere: &BoundingSphere) -> (L, L, L::Mask) {
+        let (t_min, t_max) = (self.t_min, self.t_max);
+        let c = sphere.center;
+        let m = self.origin - LaneVec3::splat(c);
+        let d = self.dir;
+        let dd = d.dot(d);
+        let t_c = -(m.dot(d) / dd);
+        let q = m + d * t_c;
+        let qq = q.dot(q);
+        // The f32 rounding of `m`, `t_c` and `q` (a few ulps of the coordinates that make
+        // them) and of the tracer's own point and field near the sphere.
+        let o = self.origin.abs();
+        let scale = o.x + o.y + o.z + L::splat(c.x.abs() + c.y.abs() + c.z.abs() + sphere.radius);
+        let slack = L::splat(8.0 * f32::EPSILON) * scale;
+        let e = self.eps_rel;
+        let a = dd - e * e;
+        let big_a = L::splat(sphere.radius) + slack + self.eps_abs + e * t_c;
+        let disc = big_a * big_a * dd - a * qq;
+        let root = disc.max(L::splat(0.0)).sqrt();
+        let (u0, u1) = ((big_a * e - root) / a, (big_a * e + root) / a);
+        let (t0, t1) = ((t_c + u0).max(t_min), (t_c + u1).min(t_max));
+        // No real root: the ray stays outside the grown sphere (a NaN `disc` is kept).
+        let outside = disc.lt(L::splat(0.0));
+        let t0 = L::select(outside, L::splat(f32::INFINITY), t0);
+        let t1 = L::select(outside, L::splat(f32::NEG_INFINITY), t1);
+        let (t0, t1, kept) = widen(t0, t1, t_min, t_max);
+        let everything = L::or(self.degenerate, L::not(a.gt(L::splat(0.0))));
+        (
+            L::select(everything, t_min, t0),
+            L::select(everything, t_max, t1),
+            L::or(everything, kept),
+        )
     }
 
     /// [`RayClip::clip_half_space`] for each lane's ray, as [`RayClipLanes::clip_box_lanes`].
@@ -544,6 +625,77 @@ mod tests {
         // t = 1e-3 / (1e-3 - 1e-4) ~ 1.1, still over the floor, so it is kept.
         let creeping = Ray::new(Vec3::new(-0.9, 1e-3, 0.3), Vec3::new(1.0, 1e-4, 0.0));
         assert!(floor.hit_interval(&creeping, &p).is_some());
+    }
+
+    #[test]
+    fn sphere_interval_is_the_grown_sphere() {
+        let b = BoundingSphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        };
+        let p = params();
+        let hit = Ray::new(Vec3::new(0.0, 0.0, -10.0), Vec3::Z);
+        let (t0, t1) = b.hit_interval(&hit, &p).unwrap();
+        // Radius 1 + 1e-4 + 1e-3 t: enters at t0 (1 + 1e-4 + 1e-3 t0 = 10 - t0), leaves at
+        // t1 (t1 - 10 = 1 + 1e-4 + 1e-3 t1).
+        let want0 = (10.0 - 1.0 - 1e-4) / (1.0 + 1e-3);
+        let want1 = (10.0 + 1.0 + 1e-4) / (1.0 - 1e-3);
+        assert!((t0 - want0).abs() < 1e-3 && t0 <= want0, "{t0} {want0}");
+        assert!((t1 - want1).abs() < 1e-3 && t1 >= want1, "{t1} {want1}");
+        // Passing 0.005 from the surface at t = 10 (threshold ~0.0101): kept, with the
+        // interval about the closest approach.
+        let graze = Ray::new(Vec3::new(0.0, 1.005, -10.0), Vec3::Z);
+        let (g0, g1) = b.hit_interval(&graze, &p).unwrap();
+        assert!(g0 < 10.0 && 10.0 < g1 && g1 - g0 < 1.0, "{g0} {g1}");
+        // Passing 0.05 from it, inside its box: nothing to march.
+        let near = Ray::new(Vec3::new(0.0, 0.7, -10.0), Vec3::new(0.0, 0.07, 1.0));
+        assert_eq!(b.hit_interval(&near, &p), None);
+        // Behind the ray, beyond t_max, or before t_min.
+        let away = Ray::new(Vec3::new(0.0, 0.0, -10.0), -Vec3::Z);
+        assert_eq!(b.hit_interval(&away, &p), None);
+        let short = TraceParams { t_max: 5.0, ..p };
+        assert_eq!(b.hit_interval(&hit, &short), None);
+        // From inside, the interval starts at t_min.
+        let inside = Ray::new(Vec3::ZERO, Vec3::X);
+        assert_eq!(b.hit_interval(&inside, &p).unwrap().0, 0.0);
+    }
+
+    /// Scale-free: a 1 mm sphere 1 km from the ray's origin, and a 1 km sphere seen from 1
+    /// mm off its surface, each with rays that graze it by a tenth of the threshold (kept,
+    /// holding the closest point) and that pass wide of it (left out): a hundred
+    /// thresholds for the small one, 1 cm for the large one, whose coordinates round to
+    /// 0.06 mm in `f32`.
+    #[test]
+    fn sphere_interval_at_the_extremes_of_scale() {
+        for (center, radius, from, wide) in [
+            (Vec3::new(1000.0, 3.0, -2.0), 1e-3, Vec3::ZERO, 0.1),
+            (Vec3::new(0.0, -1000.0, 0.0), 1000.0, Vec3::new(0.0, 1e-3, 0.0), 1e-2),
+        ] {
+            let b = BoundingSphere { center, radius };
+            let p = TraceParams {
+                t_min: 0.0,
+                t_max: 1e5,
+                max_steps: 512,
+                eps_abs: 1e-6,
+                eps_rel: 1e-6,
+            };
+            // A point on the sphere, and a tangent direction there.
+            let normal = (from - center).normalize();
+            let tangent = normal.cross(Vec3::Z).normalize();
+            let surface = center + normal * radius;
+            let distance = (surface - from).length().max(1.0);
+            let threshold = p.eps_abs.max(p.eps_rel * distance);
+            for (offset, kept) in [(0.1 * threshold, true), (wide, false)] {
+                let at = surface + normal * offset;
+                let origin = at - tangent * distance;
+                let ray = Ray::new(origin, tangent);
+                let got = b.hit_interval(&ray, &p);
+                assert_eq!(got.is_some(), kept, "{radius}: {offset} off, {got:?}");
+                if let Some((t0, t1)) = got {
+                    assert!(t0 <= distance && distance <= t1, "{t0} {distance} {t1}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -63,7 +63,7 @@ mod trace;
 pub use glam::{Quat, Vec3};
 
 pub use crate::blend::{smooth_max, smooth_min};
-pub use crate::bound::{Aabb, HalfSpace, RayClip, RayClipLanes};
+pub use crate::bound::{Aabb, BoundingSphere, HalfSpace, RayClip, RayClipLanes};
 pub use crate::field::DistanceField;
 pub use crate::lanes::{
     Avx2, Avx512, BitMask, BoolMask, Isa, Lane, LaneDistance, LaneKernel, LaneMask, LaneVec3, Mask,

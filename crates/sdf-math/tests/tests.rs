@@ -4,7 +4,8 @@
 //! on every machine.
 
 use lueur_sdf_math::{
-    DistanceField, LaneDistance, PreparedSdf, Primitive, Quat, Ray, Sdf, SimdLevel, TraceOutcome,
+    BoundingSphere, DistanceField, LaneDistance, PreparedSdf, Primitive, Quat, Ray, Sdf, SimdLevel,
+    TraceOutcome,
     TraceParams, Vec3, normal, normal_central, sphere_trace,
 };
 use proptest::prelude::*;
@@ -402,6 +403,14 @@ mod checks {
             prop_assert!(
                 got.is_some_and(|(t0, t1)| t0 <= back && back <= t1),
                 "f({at}) = {f} at t = {back}, but the box {b:?} gives {got:?} for {ray:?}"
+            );
+        }
+        if let Some((center, radius)) = sdf.bounding_sphere() {
+            let b = BoundingSphere { center, radius };
+            let got = b.hit_interval(&ray, &params);
+            prop_assert!(
+                got.is_some_and(|(t0, t1)| t0 <= back && back <= t1),
+                "f({at}) = {f} at t = {back}, but the sphere {b:?} gives {got:?} for {ray:?}"
             );
         }
         if let Some(h) = sdf.bounding_half_space() {
