@@ -5,9 +5,10 @@
 
 use glam::Vec3;
 use lueur_sdf_math::{
-    Aabb, BoundingSphere, DistanceField, HalfSpace, Lane, LaneDistance, LaneKernel, LaneVec3, MAX_LANES,
-    OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClipLanes, Sdf, SimdLevel, StreamField,
-    TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed_stream_of, write_lane,
+    Aabb, BoundingSphere, DistanceField, HalfSpace, Lane, LaneDistance, LaneKernel, LaneVec3,
+    MAX_LANES, OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClipLanes, Sdf, SimdLevel,
+    StreamField, TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed_stream_of,
+    write_lane,
 };
 
 use lueur_scene::{Marching, Object};
@@ -50,7 +51,13 @@ struct Ordered {
 enum ObjectBound {
     /// The object's bounding box; `cull` when checking the box is cheaper than evaluating
     /// the object (not for boxes, whose box check costs as much as they do).
-    Box { aabb: Aabb, cull: bool },
+    Box {
+        aabb: Aabb,
+        cull: bool,
+        /// The object's bounding sphere too, where it has one: the ray is kept where both
+        /// keep it (the box leaves the sphere's flanks out, the sphere the box's corners).
+        sphere: Option<BoundingSphere>,
+    },
     /// A sphere's own sphere: its box holds the rays that pass near its silhouette, and
     /// those are the long marches (docs/PERFORMANCE.md, "Spheres clipped by their
     /// sphere").
@@ -67,7 +74,13 @@ impl ObjectBound {
             ObjectBound::Sphere(BoundingSphere { center, radius })
         } else if let Some(aabb) = sdf.bounding_box() {
             let cull = !is_sphere(sdf) && !is_box(sdf);
-            ObjectBound::Box { aabb, cull }
+            let sphere =
+                (sdf.bounding_sphere()).map(|(center, radius)| BoundingSphere { center, radius });
+            ObjectBound::Box {
+                aabb,
+                cull,
+                sphere: sphere.filter(|_| cull),
+            }
         } else if let Some(h) = sdf.bounding_half_space() {
             ObjectBound::HalfSpace(h)
         } else {
@@ -217,11 +230,16 @@ impl LaneKernel for Clip<'_> {
                 let mut kept = L::splat(0.0);
                 for (j, entry) in entries.iter().enumerate() {
                     let (t0, t1, keep) = match &entry.bound {
-                        ObjectBound::Box { aabb, .. } => {
-                            match clip.clip_box_lanes_in(aabb, live) {
-                                Some(clip) => clip,
+                        ObjectBound::Box { aabb, sphere, .. } => {
+                            match (clip.clip_box_lanes_in(aabb, live), sphere) {
+                                (Some((t0, t1, keep)), Some(sphere)) => {
+                                    let (s0, s1, inside) = clip.clip_sphere_lanes(sphere);
+                                    let (t0, t1) = (t0.max(s0), t1.min(s1));
+                                    (t0, t1, L::and(L::and(keep, inside), L::not(t0.gt(t1))))
+                                }
+                                (Some(clip), None) => clip,
                                 // No ray of the group keeps the object.
-                                None => continue,
+                                (None, _) => continue,
                             }
                         }
                         ObjectBound::Sphere(sphere) => clip.clip_sphere_lanes(sphere),
@@ -362,7 +380,10 @@ impl StreamField for CandidateLanes<'_> {
             let mut active = L::load(&member[..lanes]).gt(zero);
             // The box is at most as far as the object (its contract): where it is already
             // farther than the running minimum, the object cannot lower it.
-            if let ObjectBound::Box { aabb, cull: true } = &entry.bound {
+            if let ObjectBound::Box {
+                aabb, cull: true, ..
+            } = &entry.bound
+            {
                 let beyond = L::and(d.gt(zero), aabb.distance_squared_lanes(p).ge(d * d));
                 active = L::and(active, L::not(beyond));
                 if !L::any(active) {

@@ -669,7 +669,12 @@ mod tests {
     fn sphere_interval_at_the_extremes_of_scale() {
         for (center, radius, from, wide) in [
             (Vec3::new(1000.0, 3.0, -2.0), 1e-3, Vec3::ZERO, 0.1),
-            (Vec3::new(0.0, -1000.0, 0.0), 1000.0, Vec3::new(0.0, 1e-3, 0.0), 1e-2),
+            (
+                Vec3::new(0.0, -1000.0, 0.0),
+                1000.0,
+                Vec3::new(0.0, 1e-3, 0.0),
+                1e-2,
+            ),
         ] {
             let b = BoundingSphere { center, radius };
             let p = TraceParams {

@@ -5,8 +5,7 @@
 
 use lueur_sdf_math::{
     BoundingSphere, DistanceField, LaneDistance, PreparedSdf, Primitive, Quat, Ray, Sdf, SimdLevel,
-    TraceOutcome,
-    TraceParams, Vec3, normal, normal_central, sphere_trace,
+    TraceOutcome, TraceParams, Vec3, normal, normal_central, sphere_trace,
 };
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
