@@ -74,13 +74,9 @@ impl ObjectBound {
             ObjectBound::Sphere(BoundingSphere { center, radius })
         } else if let Some(aabb) = sdf.bounding_box() {
             let cull = !is_sphere(sdf) && !is_box(sdf);
-            let sphere =
-                (sdf.bounding_sphere()).map(|(center, radius)| BoundingSphere { center, radius });
-            ObjectBound::Box {
-                aabb,
-                cull,
-                sphere: sphere.filter(|_| cull),
-            }
+            let sphere = (sdf.bounding_sphere().filter(|_| cull))
+                .map(|(center, radius)| BoundingSphere { center, radius });
+            ObjectBound::Box { aabb, cull, sphere }
         } else if let Some(h) = sdf.bounding_half_space() {
             ObjectBound::HalfSpace(h)
         } else {
