@@ -434,10 +434,13 @@ impl<L: Lane> RayClipLanes<L> {
         let q = m + d * t_c;
         let qq = q.dot(q);
         // The f32 rounding of `m`, `t_c` and `q` (a few ulps of the coordinates that make
-        // them) and of the tracer's own point and field near the sphere.
-        let o = self.origin.abs();
-        let scale = o.x + o.y + o.z + L::splat(c.x.abs() + c.y.abs() + c.z.abs() + sphere.radius);
-        let slack = L::splat(8.0 * f32::EPSILON) * scale;
+        // them) and of the tracer's own point and field near the sphere. No more: a ray
+        // leaves a surface from 16 roundings above it (the integrator's spawn offset), and
+        // a slack as wide would keep the sphere it leaves as a candidate, whose small
+        // values near the origin make the march crawl away from it.
+        let scale =
+            self.origin.abs().max_element() + L::splat(c.abs().max_element() + sphere.radius);
+        let slack = L::splat(4.0 * f32::EPSILON) * scale;
         let e = self.eps_rel;
         let a = dd - e * e;
         let big_a = L::splat(sphere.radius) + slack + self.eps_abs + e * t_c;
@@ -701,6 +704,54 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Every point a tracer would call a hit on a moved sphere, with the field as the
+    /// tracer evaluates it (`PreparedSdf`, in `f32` at the rounded point), lies in the
+    /// interval: rays that graze, cross or leave spheres of radius 1e-3 to 1e3 whose centres
+    /// are up to 1e4 from the origin, with the thresholds of camera and bounce rays.
+    #[test]
+    fn sphere_interval_holds_every_hit_of_the_tracer() {
+        use crate::{DistanceField, PreparedSdf, Primitive, Sdf};
+        let spread = |i: u32, k: u32| (i.wrapping_mul(k) % 10_007) as f32 / 10_007.0 - 0.5;
+        let mut hits = 0;
+        for i in 0..20_000u32 {
+            let radius = [1e-3, 1e-1, 1.0, 1e1, 1e3][(i % 5) as usize];
+            let far = [0.0, 1.0, 1e2, 1e4][(i / 5 % 4) as usize];
+            let center =
+                Vec3::new(spread(i, 7919), spread(i, 104_729), spread(i, 15_485_863)) * far;
+            let sdf = PreparedSdf::new(&Sdf::from(Primitive::Sphere { radius }).translate(center));
+            let sphere = BoundingSphere { center, radius };
+            // Aim at a point near the surface, from a distance of 1e-5 to 10 radii.
+            let toward = Vec3::new(spread(i, 611_953), spread(i, 3571), spread(i, 2_750_159))
+                .normalize_or(Vec3::X);
+            let target = center + toward * radius * (1.0 + 0.02 * spread(i, 31));
+            let dir = Vec3::new(spread(i, 1009), spread(i, 7_368_787), spread(i, 4099))
+                .normalize_or(Vec3::Y);
+            let back = radius * [1e-5, 1e-2, 1.0, 10.0][(i / 20 % 4) as usize];
+            let ray = Ray::new(target - dir * back, dir);
+            let params = TraceParams {
+                t_min: 0.0,
+                t_max: 1e6,
+                max_steps: 512,
+                eps_abs: [0.0, 1e-6][(i % 2) as usize],
+                eps_rel: [1e-4, 1e-3][(i / 2 % 2) as usize],
+            }
+            .resolving(ray.origin);
+            let interval = sphere.hit_interval(&ray, &params);
+            for k in 0..64 {
+                let t = back * 2.0 * k as f32 / 63.0;
+                let f = sdf.distance(ray.at(t));
+                if f < params.eps_abs.max(params.eps_rel * t) {
+                    hits += 1;
+                    assert!(
+                        interval.is_some_and(|(t0, t1)| t0 <= t && t <= t1),
+                        "case {i}: f = {f} at t = {t}, interval {interval:?}"
+                    );
+                }
+            }
+        }
+        assert!(hits > 10_000, "{hits} hits checked");
     }
 
     #[test]
