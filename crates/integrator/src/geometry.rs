@@ -70,12 +70,13 @@ enum ObjectBound {
 
 impl ObjectBound {
     fn of(sdf: &Sdf) -> ObjectBound {
-        if let (true, Some((center, radius))) = (is_sphere(sdf), sdf.bounding_sphere()) {
-            ObjectBound::Sphere(BoundingSphere { center, radius })
+        let sphere =
+            (sdf.bounding_sphere()).map(|(center, radius)| BoundingSphere { center, radius });
+        if let (true, Some(sphere)) = (is_sphere(sdf), sphere) {
+            ObjectBound::Sphere(sphere)
         } else if let Some(aabb) = sdf.bounding_box() {
             let cull = !is_sphere(sdf) && !is_box(sdf);
-            let sphere = (sdf.bounding_sphere().filter(|_| cull))
-                .map(|(center, radius)| BoundingSphere { center, radius });
+            let sphere = sphere.filter(|_| cull);
             ObjectBound::Box { aabb, cull, sphere }
         } else if let Some(h) = sdf.bounding_half_space() {
             ObjectBound::HalfSpace(h)
