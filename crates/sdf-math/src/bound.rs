@@ -435,9 +435,10 @@ impl<L: Lane> RayClipLanes<L> {
         let qq = q.dot(q);
         // The f32 rounding of `m`, `t_c` and `q` (a few ulps of the coordinates that make
         // them) and of the tracer's own point and field near the sphere. No more: a ray
-        // leaves a surface from 16 roundings above it (the integrator's spawn offset), and
-        // a slack as wide would keep the sphere it leaves as a candidate, whose small
-        // values near the origin make the march crawl away from it.
+        // leaves a surface from 32 roundings of the hit above it (the integrator's spawn
+        // offset, which covers this slack, at most about 23 such roundings), and a wider
+        // slack would keep the sphere it leaves as a candidate, whose small values near the
+        // origin make the march crawl away from it.
         let scale =
             self.origin.abs().max_element() + L::splat(c.abs().max_element() + sphere.radius);
         let slack = L::splat(4.0 * f32::EPSILON) * scale;
