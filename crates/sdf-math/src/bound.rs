@@ -517,6 +517,12 @@ impl HalfSpace {
 mod tests {
     use super::*;
 
+    /// A number in `[-0.5, 0.5)` for case `i` and stream `k`: a cheap, fixed
+    /// spread of test cases (distinct primes `k` give unrelated streams).
+    fn spread(i: u32, k: u32) -> f32 {
+        (i.wrapping_mul(k) % 10_007) as f32 / 10_007.0 - 0.5
+    }
+
     fn params() -> TraceParams {
         TraceParams {
             t_min: 0.0,
@@ -533,7 +539,6 @@ mod tests {
     /// coordinates up to 1e4, with degenerate rays and ranges among them.
     #[test]
     fn early_miss_of_a_box_is_exact() {
-        let spread = |i: u32, k: u32| (i.wrapping_mul(k) % 10_007) as f32 / 10_007.0 - 0.5;
         let (mut early, mut checked) = (0, 0);
         for i in 0..40_000u32 {
             let scale = [1e-4, 1e-2, 1.0, 1e2, 1e4][(i % 5) as usize];
@@ -714,7 +719,6 @@ mod tests {
     #[test]
     fn sphere_interval_holds_every_hit_of_the_tracer() {
         use crate::{DistanceField, PreparedSdf, Primitive, Sdf};
-        let spread = |i: u32, k: u32| (i.wrapping_mul(k) % 10_007) as f32 / 10_007.0 - 0.5;
         let mut hits = 0;
         for i in 0..20_000u32 {
             let radius = [1e-3, 1e-1, 1.0, 1e1, 1e3][(i % 5) as usize];
