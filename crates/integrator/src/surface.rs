@@ -840,6 +840,54 @@ mod tests {
         }
     }
 
+    /// The ray of a property test at an object `size` across at `center`: from 5 sizes
+    /// away along the direction `(theta, phi)`, moved sideways by `aim` sizes.
+    fn ray_at(center: Vec3, size: f32, theta: f32, phi: f32, aim: f32) -> Ray {
+        let dir = Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.cos(),
+            theta.sin() * phi.sin(),
+        );
+        let side = dir.any_orthonormal_vector();
+        Ray::new(center - dir * 5.0 * size + side * aim * size, dir)
+    }
+
+    /// A white scene of `objects` seen from `ray`'s origin toward `look_at`, its march, and
+    /// where `ray` meets object 0, shaded as a secondary ray's hit, with the tracer's shell
+    /// there (`None` where it meets no surface of object 0).
+    fn shaded_hit(
+        objects: Vec<Sdf>,
+        ray: &Ray,
+        look_at: Vec3,
+    ) -> (PreparedScene, March, Option<(SurfacePoint, f32)>) {
+        let camera =
+            Camera::new(ray.origin, look_at, ray.dir.any_orthonormal_vector(), 40.0).unwrap();
+        let objects = (objects.into_iter())
+            .map(|sdf| Object { sdf, material: 0 })
+            .collect();
+        let white = Material::Lambertian { albedo: Vec3::ONE };
+        let scene: PreparedScene = Scene::new(objects, vec![white], vec![], None, camera)
+            .unwrap()
+            .into();
+        let march = March::new(&scene, &RenderSettings::default());
+        let mut counters = crate::TraceCounters::default();
+        let shaded = match scene.intersect(ray, &march.secondary, march.marching, &mut counters) {
+            Some(Hit::Surface {
+                t,
+                object: 0,
+                epsilon,
+                ..
+            }) => {
+                let hit = ray.at(t);
+                let precision = HitPrecision::at(scene.prepared(0), hit, epsilon, false);
+                let s = SurfacePoint::new(scene.prepared(0), hit, -ray.dir, precision, &march);
+                Some((s, epsilon))
+            }
+            _ => None,
+        };
+        (scene, march, shaded)
+    }
+
     proptest::proptest! {
         #![proptest_config(proptest::prelude::ProptestConfig::with_cases(512))]
 
@@ -867,32 +915,16 @@ mod tests {
             // Up to 2000 sizes from the origin, and 1e3.
             let center = (Vec3::new(cx, cy, cz) * size * 10f32.powf(far)).clamp_length_max(1e3);
             proptest::prop_assume!(0.3 * size >= 1e3 * position_rounding(center));
-            let half = Vec3::new(1.0, 0.4, 0.7) * size;
-            let dir = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
-            let side = dir.any_orthonormal_vector();
+            let ray = ray_at(center, size, theta, phi, aim);
             let object = match kind {
                 0 => Sdf::sphere(size),
-                1 => Sdf::cuboid(half),
-                _ => Sdf::plane(side * 0.4 - dir, 0.0),
+                1 => Sdf::cuboid(Vec3::new(1.0, 0.4, 0.7) * size),
+                _ => Sdf::plane(ray.dir.any_orthonormal_vector() * 0.4 - ray.dir, 0.0),
             }
             .translate(center);
-            let origin = center - dir * 5.0 * size + side * aim * size;
-            let ray = Ray::new(origin, dir);
-            let camera = Camera::new(origin, center, side, 40.0).unwrap();
-            let white = Material::Lambertian { albedo: Vec3::ONE };
-            let objects = vec![Object { sdf: object, material: 0 }];
-            let scene: PreparedScene =
-                Scene::new(objects, vec![white], vec![], None, camera).unwrap().into();
-            let march = March::new(&scene, &RenderSettings::default());
-            let mut counters = crate::TraceCounters::default();
-            let Some(Hit::Surface { t, epsilon, .. }) =
-                scene.intersect(&ray, &march.secondary, march.marching, &mut counters)
-            else {
+            let (scene, march, Some((s, _))) = shaded_hit(vec![object], &ray, center) else {
                 return Ok(());
             };
-            let hit = ray.at(t);
-            let precision = HitPrecision::at(scene.prepared(0), hit, epsilon, false);
-            let s = SurfacePoint::new(scene.prepared(0), hit, -ray.dir, precision, &march);
             proptest::prop_assume!(!s.inside);
             let frame = lueur_sampling::Frame::from_normal(s.n);
             let mut leaving = Vec::new();
@@ -941,31 +973,13 @@ mod tests {
             let center = Vec3::new(cx, cy, cz);
             proptest::prop_assume!(0.3 * size >= 1e3 * position_rounding(center));
             let object = shape(kind, size).translate(center);
-            let dir = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
-            let side = dir.any_orthonormal_vector();
-            let origin = center - dir * 5.0 * size + side * aim * size;
-            let ray = Ray::new(origin, dir);
-            let camera = Camera::new(origin, center, dir.any_orthonormal_vector(), 40.0)
-                .unwrap();
+            let ray = ray_at(center, size, theta, phi, aim);
             let mut offsets = Vec::new();
             for others in [rest_of_scene(0, 0.0), rest_of_scene(rest, cy - 2.0 * size)] {
-                let objects = std::iter::once(object.clone())
-                    .chain(others)
-                    .map(|sdf| Object { sdf, material: 0 })
-                    .collect();
-                let white = Material::Lambertian { albedo: Vec3::ONE };
-                let scene: PreparedScene =
-                    Scene::new(objects, vec![white], vec![], None, camera).unwrap().into();
-                let march = March::new(&scene, &RenderSettings::default());
-                let mut counters = crate::TraceCounters::default();
-                let Some(Hit::Surface { t, object: 0, epsilon, .. }) =
-                    scene.intersect(&ray, &march.secondary, march.marching, &mut counters)
-                else {
+                let objects = std::iter::once(object.clone()).chain(others).collect();
+                let (_, _, Some((s, epsilon))) = shaded_hit(objects, &ray, center) else {
                     continue;
                 };
-                let hit = ray.at(t);
-                let precision = HitPrecision::at(scene.prepared(0), hit, epsilon, false);
-                let s = SurfacePoint::new(scene.prepared(0), hit, -ray.dir, precision, &march);
                 let offset = (s.origin - s.p).length();
                 let rounding = position_rounding(s.p) + f32::EPSILON * size;
                 let bound = 64.0 * rounding + 2.0 * epsilon;
