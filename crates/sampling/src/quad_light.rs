@@ -124,8 +124,11 @@ pub fn quad_area_pdf(p: Vec3, corner: Vec3, edge_u: Vec3, edge_v: Vec3, wi: Vec3
 /// Spherical Rectangles", EGSR, Algorithm 1 (also pbrt-v4
 /// `SampleSphericalRectangle`). Computed in f64: the solid angle is
 /// `g0 + g1 + g2 + g3 - 2pi`, a sum of interior angles that cancels badly for
-/// small rectangles, and the interior angles are taken with `atan2` rather than
-/// the paper's `acos`, which is ill-conditioned at grazing views.
+/// small rectangles. Each interior angle is the argument of a complex number
+/// (accurate near 0 and pi, where the paper's `acos` is not), so their sum is
+/// the argument of the product: one `atan2` for the solid angle, and `k` (the
+/// angle the sampling starts from) kept as its cosine and sine, which the product
+/// of the last two gives without trigonometry.
 #[derive(Clone, Copy, Debug)]
 pub struct SphericalRectangle {
     o: DVec3,
@@ -139,9 +142,18 @@ pub struct SphericalRectangle {
     y1: f64,
     b0: f64,
     b1: f64,
-    k: f64,
+    /// `cos k` and `sin k` of the paper's `k = 2pi - g2 - g3`.
+    cos_k: f64,
+    sin_k: f64,
     solid_angle: f64,
     normal: Vec3,
+}
+
+/// A complex number as `(re, im)`.
+type Complex = (f64, f64);
+
+fn times((a, b): Complex, (c, d): Complex) -> Complex {
+    (a * c - b * d, a * d + b * c)
 }
 
 impl SphericalRectangle {
@@ -157,7 +169,8 @@ impl SphericalRectangle {
     /// The spherical rectangle of the light seen from `p`. `None` when the
     /// edges are not perpendicular (within [`Self::RECTANGLE_TOLERANCE`]) or
     /// degenerate, when `p` is behind or on the light's plane, or when the
-    /// solid angle is below [`Self::MIN_SOLID_ANGLE`] (use
+    /// solid angle is below [`Self::MIN_SOLID_ANGLE`] or within 1e-6 of `2pi`,
+    /// where the interior angles' sum cannot tell the two apart (use
     /// [`sample_quad_area`] then; [`sample_quad_solid_angle`] does this
     /// fallback for you).
     pub fn new(p: Vec3, corner: Vec3, edge_u: Vec3, edge_v: Vec3) -> Option<Self> {
@@ -189,33 +202,43 @@ impl SphericalRectangle {
         let y0 = d.dot(y);
         let x1 = x0 + exl;
         let y1 = y0 + ey.dot(y);
-        // Vertices in the local frame and the normals of the great circles
-        // through consecutive vertices (Ureña et al. 2013, Algorithm 1).
-        let v00 = DVec3::new(x0, y0, z0);
-        let v01 = DVec3::new(x0, y1, z0);
-        let v10 = DVec3::new(x1, y0, z0);
-        let v11 = DVec3::new(x1, y1, z0);
-        // n1 and n3 only enter angles, which do not need unit normals.
-        let n0 = v00.cross(v10).normalize();
-        let n1 = v10.cross(v11);
-        let n2 = v11.cross(v01).normalize();
-        let n3 = v01.cross(v00);
-        // Interior angle between consecutive edges: acos(-n_i . n_j), i.e.
-        // the argument of (-n_i . n_j, |n_i x n_j|), accurate near 0 and pi
-        // where acos is not. The algorithm needs only g0 + g1 and g2 + g3:
-        // each is the argument of a product of two such complex numbers,
-        // one atan2 instead of two (the sums lie in (0, 2pi); atan2 returns
-        // (-pi, pi], hence the wrap).
-        let turn = |a: DVec3, b: DVec3| (-a.dot(b), a.cross(b).length());
-        let sum_of_angles = |(c0, s0): (f64, f64), (c1, s1): (f64, f64)| {
-            let angle = (c0 * s1 + s0 * c1).atan2(c0 * c1 - s0 * s1);
-            if angle <= 0.0 { angle + TAU } else { angle }
+        // The paper's great-circle normals through consecutive vertices
+        // `(x_i, y_j, z0)` are, up to positive factors, n0 = (0, z0, -y0),
+        // n1 = (-z0, 0, x1), n2 = (0, -z0, y1), n3 = (z0, 0, -x0). The interior
+        // angle between n_i and n_j is the argument of (-n_i . n_j, |n_i x n_j|),
+        // and the cross product's length is |z0| times the distance to the vertex
+        // the two circles share. In units of the largest coordinate, so that the
+        // product of four stays far from overflow and underflow.
+        let unit = 1.0 / x0.abs().max(x1.abs()).max(y0.abs()).max(y1.abs()).max(-z0);
+        let (a0, a1, b0, b1, c) = (x0 * unit, x1 * unit, y0 * unit, y1 * unit, -z0 * unit);
+        let c2 = c * c;
+        let to = |a: f64, b: f64| c * (a * a + b * b + c2).sqrt();
+        let g0 = (b0 * a1, to(a1, b0));
+        let g1 = (-a1 * b1, to(a1, b1));
+        let g2 = (a0 * b1, to(a0, b1));
+        let g3 = (-a0 * b0, to(a0, b0));
+        let g23 = times(g2, g3);
+        let (re, im) = times(times(g0, g1), g23);
+        // The argument of the product is the solid angle modulo 2pi. Every
+        // interior angle is in (0, pi), so the sum is in (2pi, 6pi) and the solid
+        // angle in (0, 2pi): a negative argument is the solid angle less 2pi,
+        // unless it is a rounding of a solid angle near 0 or near 2pi, which
+        // cannot be told apart and are declined.
+        let angle = libm::atan2(im, re);
+        let solid_angle = if angle >= 0.0 {
+            angle
+        } else if angle < -1e-6 {
+            angle + TAU
+        } else {
+            return None;
         };
-        let g01 = sum_of_angles(turn(n0, n1), turn(n1, n2));
-        let g23 = sum_of_angles(turn(n2, n3), turn(n3, n0));
-        let k = TAU - g23;
-        let solid_angle = g01 - k;
         if !(solid_angle.is_finite() && solid_angle >= f64::from(Self::MIN_SOLID_ANGLE)) {
+            return None;
+        }
+        // k = 2pi - (g2 + g3): cos k = cos(g2 + g3), sin k = -sin(g2 + g3).
+        let length = g23.0.hypot(g23.1);
+        let (cos_k, sin_k) = (g23.0 / length, -g23.1 / length);
+        if !(cos_k.is_finite() && sin_k.is_finite()) {
             return None;
         }
         Some(Self {
@@ -228,9 +251,11 @@ impl SphericalRectangle {
             y0,
             x1,
             y1,
-            b0: n0.z,
-            b1: n2.z,
-            k,
+            // The z components of the unit n0 and n2.
+            b0: -b0 / (b0 * b0 + c2).sqrt(),
+            b1: b1 / (b1 * b1 + c2).sqrt(),
+            cos_k,
+            sin_k,
             solid_angle,
             normal,
         })
@@ -256,8 +281,11 @@ impl SphericalRectangle {
     /// [`DirectionSample`].
     pub fn sample(&self, u: Vec2) -> Option<DirectionSample> {
         let u = clamp_u2(u).as_dvec2();
-        let au = u.x * self.solid_angle + self.k;
-        let fu = (au.cos() * self.b0 - self.b1) / au.sin();
+        // au = u.x S + k, by the angle-sum formulas.
+        let (sin_us, cos_us) = libm::sincos(u.x * self.solid_angle);
+        let cos_au = cos_us * self.cos_k - sin_us * self.sin_k;
+        let sin_au = sin_us * self.cos_k + cos_us * self.sin_k;
+        let fu = (cos_au * self.b0 - self.b1) / sin_au;
         let cu = (1.0 / (fu * fu + self.b0 * self.b0).sqrt()).copysign(fu);
         // Keep away from +-1 so that sqrt(1 - cu^2) is not 0 (pbrt-v4 does the
         // same); then clamp xu into the rectangle.
@@ -432,6 +460,45 @@ mod tests {
                 .unwrap();
         let expected = 4.0 * (0.25f64 / 1.25).asin();
         assert!((f64::from(rect.solid_angle()) - expected).abs() < 1e-6);
+    }
+
+    /// Near the light's plane, under it, the solid angle nears `2pi`, and the sum of the
+    /// interior angles, taken modulo `2pi`, nears 0 from below: those solid angles come
+    /// out right down to 1e-6 from `2pi`, and closer ones are declined (area sampling
+    /// takes over), never taken as solid angles near 0.
+    #[test]
+    fn solid_angles_near_two_pi_are_right_or_declined() {
+        let corner = Vec3::new(-0.5, 0.5, 0.0);
+        let mut exact = 0;
+        for k in 0..=60 {
+            let height = 10f32.powf(-0.1 * k as f32);
+            let p = Vec3::new(0.1, -0.05, -height);
+            let (a, b) = (DVec3::new(0.6, 0.55, 0.0), DVec3::new(0.4, 0.45, 0.0));
+            let h = f64::from(height);
+            // A rectangle seen from a point over its inside: four rectangles with a
+            // corner over the point, each `atan(xy / (h sqrt(x^2 + y^2 + h^2)))`.
+            let expected: f64 = [(a.x, a.y), (a.x, b.y), (b.x, a.y), (b.x, b.y)]
+                .iter()
+                .map(|&(x, y)| (x * y / (h * (x * x + y * y + h * h).sqrt())).atan())
+                .sum();
+            match SphericalRectangle::new(p, corner, Vec3::X, -Vec3::Y) {
+                Some(rect) => {
+                    let got = f64::from(rect.solid_angle());
+                    assert!(
+                        (got - expected).abs() <= 1e-6,
+                        "height {height}: {got} vs {expected}"
+                    );
+                    exact += 1;
+                }
+                None => assert!(
+                    TAU - expected < 2e-6,
+                    "height {height} declined at {expected}"
+                ),
+            }
+            let s = sample_quad_solid_angle(p, corner, Vec3::X, -Vec3::Y, Vec2::splat(0.4));
+            assert!(s.is_some_and(|s| s.wi.z > 0.0), "height {height}");
+        }
+        assert!(exact >= 50, "{exact}");
     }
 
     /// The solid angle against an independent formula, two triangles by Van
