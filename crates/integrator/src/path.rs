@@ -193,14 +193,22 @@ fn shade(
         Material::Lambertian { .. } => {
             shadow.lights.clear();
             lighting.delta_lights(&vertex, &mut shadow.lights);
-            let nee = strategy::uses_next_event(settings.strategy)
-                .then(|| lighting.next_event(&vertex, u, sphere.map(|k| spheres.drawn[k])))
-                .flatten();
-            let next_event = nee.is_some();
-            for (ray, contribution) in shadow.lights.drain(..).chain(nee) {
+            for (ray, contribution) in shadow.lights.drain(..) {
                 shadow.rays.push(ray);
                 shadow.contributions.push(contribution);
             }
+            // Pushed where it is made: moved through an `Option` and an iterator chain,
+            // the ray was stored in pieces and loaded whole, and the load waited for the
+            // stores.
+            let next_event = strategy::uses_next_event(settings.strategy)
+                && match lighting.next_event(&vertex, u, sphere.map(|k| spheres.drawn[k])) {
+                    Some((ray, contribution)) => {
+                        shadow.rays.push(ray);
+                        shadow.contributions.push(contribution);
+                        true
+                    }
+                    None => false,
+                };
             let scatter = strategy::scatter(settings.strategy, &lighting.emitters, &vertex, u);
             (true, next_event, scatter)
         }
