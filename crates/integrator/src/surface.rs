@@ -473,7 +473,13 @@ impl SurfacePoint {
             let to = self.p + wi * distance - self.origin;
             let d = to.length();
             if d > 0.0 && d.is_finite() {
-                return (Ray::new(self.origin, to / d), d);
+                // Unit already: `Ray::new` would take the square root and divide again,
+                // a chain the shading of the vertex waits on.
+                let ray = Ray {
+                    origin: self.origin,
+                    dir: to / d,
+                };
+                return (ray, d);
             }
         }
         (Ray::new(self.origin, wi), distance)

@@ -151,7 +151,9 @@ impl Material {
                 if !(pdf > 0.0) || local.z <= 0.0 {
                     return None;
                 }
-                let wi = Frame::from_normal(n).to_world(local).normalize();
+                // Unit to within a few ulps (an orthonormal frame and a unit `local`),
+                // without the square root and division the next ray waits on.
+                let wi = Frame::from_normal(n).to_world(local);
                 Some(BsdfSample {
                     wi,
                     f: albedo * FRAC_1_PI,
