@@ -239,9 +239,15 @@ impl PreparedScene {
                 counters.rays += 1;
                 continue;
             }
+            // The rare paths take a copy by reference, so that `p` itself stays in
+            // registers: built in memory a field at a time and copied whole into the
+            // queues, it made every ray wait for its stores (docs/PERFORMANCE.md, "Stores
+            // loaded whole").
             let done = if inside {
+                let p = p;
                 Some((sphere_trace(&self.geometry.inside(), &r.ray, &p), None))
             } else if tracing.marching == Marching::Naive {
+                let p = p;
                 Some(self.geometry.trace_naive(&r.ray, &p))
             } else {
                 scratch.batch.queue(i, r.ray, p);
@@ -266,7 +272,9 @@ impl PreparedScene {
         counters.timed(clock);
     }
 
-    /// The surface a march of `ray` with parameters `params` found, if any.
+    /// The surface a march of `ray` with parameters `params` found, if any. Inlined: its
+    /// result, returned through memory, was loaded whole before its stores had retired.
+    #[inline(always)]
     fn surface_hit(
         &self,
         ray: &Ray,
@@ -318,7 +326,8 @@ impl PreparedScene {
         free.clear();
         scratch.batch.clear();
         for (i, r) in rays.iter().enumerate() {
-            let params = &params.resolving(r.ray.origin);
+            // By value, not by reference, for the reason given in `intersect_rays`.
+            let params = params.resolving(r.ray.origin);
             // Stop short of the light's surface so that its own geometry (for
             // lights that are objects too) does not occlude it.
             let t_max = (r.distance * (1.0 - 1e-4) - params.eps_abs).min(params.t_max);
@@ -329,9 +338,10 @@ impl PreparedScene {
             if blocked || self.scene().objects.is_empty() || t_max <= params.t_min {
                 continue;
             }
-            let p = TraceParams { t_max, ..*params };
+            let p = TraceParams { t_max, ..params };
             match tracing.marching {
                 Marching::Naive => {
+                    let p = p;
                     let outcome = self.geometry.trace_naive(&r.ray, &p).0;
                     counters.record(&outcome);
                     free[i] = matches!(outcome, TraceOutcome::Miss { .. });
