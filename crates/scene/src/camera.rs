@@ -77,7 +77,8 @@ impl Camera {
         let dir = self.forward
             + self.right * (ndc_x * aspect * self.tan_half_vfov)
             + self.up * (ndc_y * self.tan_half_vfov);
-        Ray::new(self.position, dir.normalize())
+        // `Ray::new` normalises: once is enough.
+        Ray::new(self.position, dir)
     }
 
     /// Angle subtended by one pixel at the image centre: the footprint that
