@@ -264,16 +264,17 @@ pub(crate) fn radiance_wave(
     s.active.clear();
     s.active.extend(0..s.paths.len());
     while !s.active.is_empty() {
-        s.rays.clear();
-        s.rays.extend(s.active.iter().map(|&i| {
+        // Field by field into place: a `PathRay` made whole first was written in pieces on
+        // the stack and loaded back whole, and every ray waited for its stores
+        // (docs/PERFORMANCE.md, "Stores loaded whole").
+        s.rays.resize(s.active.len(), PathRay::UNSET);
+        for (ray, &i) in s.rays.iter_mut().zip(&s.active) {
             let path = &s.paths[i];
-            PathRay {
-                ray: path.ray,
-                from: path.previous.p,
-                params: path.params,
-                maybe_inside: path.depth == 0 && march.camera_inside || path.previous.in_solid,
-            }
-        }));
+            ray.ray = path.ray;
+            ray.from = path.previous.p;
+            ray.params = path.params;
+            ray.maybe_inside = path.depth == 0 && march.camera_inside || path.previous.in_solid;
+        }
         // Every path in flight has scattered as often as the others.
         let depth = s.paths[s.active[0]].depth;
         let kind = counters.path_ray(depth);

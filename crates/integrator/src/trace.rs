@@ -117,6 +117,25 @@ pub(crate) struct PathRay {
     pub maybe_inside: bool,
 }
 
+impl PathRay {
+    /// A placeholder for a slot about to be written.
+    pub const UNSET: PathRay = PathRay {
+        ray: Ray {
+            origin: Vec3::ZERO,
+            dir: Vec3::Z,
+        },
+        from: Vec3::ZERO,
+        params: TraceParams {
+            t_min: 0.0,
+            t_max: 0.0,
+            max_steps: 0,
+            eps_abs: 0.0,
+            eps_rel: 0.0,
+        },
+        maybe_inside: false,
+    };
+}
+
 /// A shadow ray: is the segment from `ray.origin` along `ray.dir` free of objects and of
 /// lights other than `target` up to `distance`?
 #[derive(Clone, Copy, Debug)]
