@@ -142,6 +142,8 @@ pub struct SphericalRectangle {
     y1: f64,
     b0: f64,
     b1: f64,
+    /// `1 - b0^2`, in a form that does not cancel.
+    one_minus_b0_squared: f64,
     /// `cos k` and `sin k` of the paper's `k = 2pi - g2 - g3`.
     cos_k: f64,
     sin_k: f64,
@@ -236,7 +238,9 @@ impl SphericalRectangle {
             return None;
         }
         // k = 2pi - (g2 + g3): cos k = cos(g2 + g3), sin k = -sin(g2 + g3).
-        let length = g23.0.hypot(g23.1);
+        // Not `hypot`: the turns are in units of the largest coordinate, far from
+        // overflow, and glibc's `hypot` is a call.
+        let length = (g23.0 * g23.0 + g23.1 * g23.1).sqrt();
         let (cos_k, sin_k) = (g23.0 / length, -g23.1 / length);
         if !(cos_k.is_finite() && sin_k.is_finite()) {
             return None;
@@ -254,6 +258,7 @@ impl SphericalRectangle {
             // The z components of the unit n0 and n2.
             b0: -b0 / (b0 * b0 + c2).sqrt(),
             b1: b1 / (b1 * b1 + c2).sqrt(),
+            one_minus_b0_squared: c2 / (b0 * b0 + c2),
             cos_k,
             sin_k,
             solid_angle,
@@ -286,11 +291,19 @@ impl SphericalRectangle {
         let cos_au = cos_us * self.cos_k - sin_us * self.sin_k;
         let sin_au = sin_us * self.cos_k + cos_us * self.sin_k;
         let fu = (cos_au * self.b0 - self.b1) / sin_au;
-        let cu = (1.0 / (fu * fu + self.b0 * self.b0).sqrt()).copysign(fu);
-        // Keep away from +-1 so that sqrt(1 - cu^2) is not 0 (pbrt-v4 does the
-        // same); then clamp xu into the rectangle.
-        let cu = cu.clamp(-1.0 + f64::EPSILON, 1.0 - f64::EPSILON);
-        let xu = (-(cu * self.z0) / (1.0 - cu * cu).sqrt()).clamp(self.x0, self.x1);
+        // The paper's xu = -cu z0 / sqrt(1 - cu^2) with cu = sign(fu) / sqrt(fu^2 +
+        // b0^2) is sign(fu) |z0| / sqrt(fu^2 - (1 - b0^2)): one square root and one
+        // division fewer on the chain, and no cancellation in 1 - cu^2. Where the
+        // root is 0 or rounding makes it imaginary, cu is +-1 and xu is the edge
+        // of the rectangle on fu's side (pbrt-v4 keeps cu off +-1 for the same
+        // end); then xu is clamped into the rectangle.
+        let g = fu * fu - self.one_minus_b0_squared;
+        let xu = if g > 0.0 {
+            (-self.z0).copysign(fu) / g.sqrt()
+        } else {
+            f64::INFINITY.copysign(fu)
+        };
+        let xu = xu.clamp(self.x0, self.x1);
         let d = (xu * xu + self.z0 * self.z0).sqrt();
         let h0 = self.y0 / (d * d + self.y0 * self.y0).sqrt();
         let h1 = self.y1 / (d * d + self.y1 * self.y1).sqrt();

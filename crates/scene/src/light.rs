@@ -341,11 +341,13 @@ pub(crate) fn ray_quad(ray: &Ray, corner: Vec3, edge_u: Vec3, edge_v: Vec3) -> O
     }
     let q = ray.at(t) - corner;
     // Coordinates in the (edge_u, edge_v) basis by Cramer's rule with the
-    // plane normal (works for any parallelogram).
+    // plane normal (works for any parallelogram), each times |n|^2: compared
+    // with [0, |n|^2] rather than divided by it, which would put two
+    // divisions on the chain every path ray waits on.
     let nn = n.length_squared();
-    let s = n.dot(q.cross(edge_v)) / nn;
-    let r = n.dot(edge_u.cross(q)) / nn;
-    if (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r) {
+    let s = n.dot(q.cross(edge_v));
+    let r = n.dot(edge_u.cross(q));
+    if (0.0..=nn).contains(&s) && (0.0..=nn).contains(&r) {
         Some(t)
     } else {
         None
