@@ -11,7 +11,7 @@ use lueur_sdf_math::Ray;
 
 use lueur_sdf_math::TraceParams;
 
-use crate::strategy::{self, EmissionWeight, Lighting, Scatter, Vertex, VertexSample};
+use crate::strategy::{self, CosineDraws, EmissionWeight, Lighting, Scatter, Vertex, VertexSample};
 use crate::surface::{March, SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::{PathRay, ShadowRay, TraceScratch, Tracing};
 use lueur_scene::RenderSettings;
@@ -117,14 +117,16 @@ struct Shaded {
     roulette: f32,
 }
 
-/// A vertex waiting to be shaded: its path, where it is, its numbers, and its sphere-light
-/// sample's index in the wave's [`SphereDraws`] where next-event estimation chose one.
+/// A vertex waiting to be shaded: its path, where it is, its numbers, its sphere-light
+/// sample's index in the wave's [`SphereDraws`] where next-event estimation chose one,
+/// and its direction's in the wave's [`CosineDraws`] where it scatters by the cosine.
 struct Pending {
     path: usize,
     on_surface: SurfaceHit,
     surface: SurfacePoint,
     u: VertexSample,
     sphere: Option<usize>,
+    cosine: Option<usize>,
 }
 
 /// A thread's buffers for [`radiance_wave`], kept from one wave to the next.
@@ -140,6 +142,7 @@ pub(crate) struct WaveScratch {
     surface_scratch: SurfaceScratch,
     pending: Vec<Pending>,
     spheres: SphereDraws,
+    cosines: CosineDraws,
     shaded: Vec<Shaded>,
     shadow: ShadowQueue,
     free: Vec<bool>,
@@ -168,7 +171,7 @@ fn shade(
     estimator: &Estimator<'_>,
     lighting: &Lighting<'_>,
     (pending, path): (&Pending, &Path),
-    spheres: &SphereDraws,
+    (spheres, cosines): (&SphereDraws, &CosineDraws),
     shadow: &mut ShadowQueue,
 ) -> Shaded {
     let Estimator {
@@ -180,6 +183,7 @@ fn shade(
         surface,
         ref u,
         sphere,
+        cosine,
     } = pending;
     let material = material_at(scene, on_surface);
     let vertex = Vertex {
@@ -209,7 +213,9 @@ fn shade(
                     }
                     None => false,
                 };
-            let scatter = strategy::scatter(settings.strategy, &lighting.emitters, &vertex, u);
+            let cosine = cosine.map(|k| cosines.drawn[k]);
+            let scatter =
+                strategy::scatter(settings.strategy, &lighting.emitters, &vertex, u, cosine);
             (true, next_event, scatter)
         }
     };
@@ -301,6 +307,7 @@ pub(crate) fn radiance_wave(
 
         s.pending.clear();
         s.spheres.clear();
+        s.cosines.clear();
         let mut surfaces = s.surfaces.iter();
         for (&i, &hit) in s.active.iter().zip(&s.hits) {
             let path = &mut s.paths[i];
@@ -316,23 +323,27 @@ pub(crate) fn radiance_wave(
                 .next()
                 .expect("a shading point for each hit that scatters");
             let u = VertexSample::draw(&mut samplers[i], ids[i].pixel, ids[i].index, path.depth);
-            // Next-event estimation toward a sphere light: its sample is drawn below, with
-            // the wave's others.
-            let next_event = strategy::uses_next_event(settings.strategy)
-                && matches!(material_at(scene, on_surface), Material::Lambertian { .. });
+            // Next-event estimation toward a sphere light, and the cosine-weighted
+            // direction a diffuse vertex scatters in: drawn below, with the wave's others.
+            let diffuse = matches!(material_at(scene, on_surface), Material::Lambertian { .. });
+            let next_event = strategy::uses_next_event(settings.strategy) && diffuse;
             let sphere = next_event
                 .then(|| lighting.emitters.chosen_sphere(u.emitter_choice))
                 .flatten()
                 .map(|sphere| s.spheres.request(surface.p, sphere, u.emitter));
+            let cosine = (diffuse && strategy::scatters_by_cosine(settings.strategy))
+                .then(|| s.cosines.request(u.bsdf));
             s.pending.push(Pending {
                 path: i,
                 on_surface,
                 surface,
                 u,
                 sphere,
+                cosine,
             });
         }
         s.spheres.draw(tracing.simd);
+        s.cosines.draw(tracing.simd);
 
         s.shaded.clear();
         s.shadow.rays.clear();
@@ -343,7 +354,7 @@ pub(crate) fn radiance_wave(
                 estimator,
                 &lighting,
                 (pending, path),
-                &s.spheres,
+                (&s.spheres, &s.cosines),
                 &mut s.shadow,
             ));
         }

@@ -8,8 +8,8 @@
 
 use glam::{Vec2, Vec3};
 use lueur_materials::{HemisphereSampling, Material};
-use lueur_sampling::{DirectionSample, Sampler, power_heuristic};
-use lueur_sdf_math::{Ray, TraceParams};
+use lueur_sampling::{DirectionSample, Sampler, power_heuristic, sample_cosine_hemisphere_lanes};
+use lueur_sdf_math::{Lane, LaneKernel, MAX_LANES, Ray, SimdLevel, TraceParams};
 
 use crate::light_sampler::Emitters;
 use crate::surface::{March, SurfacePoint};
@@ -135,20 +135,114 @@ pub(crate) fn mirror(v: &Vertex, u_bsdf: Vec2) -> Option<Scatter> {
     })
 }
 
-/// The direction of `strategy` at a diffuse vertex.
+/// The direction of `strategy` at a diffuse vertex; `cosine` is the cosine-weighted local
+/// direction of `u.bsdf` where it was drawn already ([`CosineDraws`]).
 #[inline]
 pub(crate) fn scatter(
     strategy: Strategy,
     emitters: &Emitters<'_>,
     v: &Vertex,
     u: &VertexSample,
+    cosine: Option<Vec3>,
 ) -> Option<Scatter> {
     match strategy {
-        Strategy::Uniform => hemisphere(v, HemisphereSampling::Uniform, u.bsdf),
-        Strategy::Cosine => hemisphere(v, HemisphereSampling::Cosine, u.bsdf),
+        Strategy::Uniform => hemisphere(v, HemisphereSampling::Uniform, u.bsdf, None),
+        Strategy::Cosine => hemisphere(v, HemisphereSampling::Cosine, u.bsdf, cosine),
         Strategy::Light => toward_emitters(emitters, v, u.emitter_choice, u.emitter),
         Strategy::Mixture => mixture(emitters, v, u),
-        Strategy::Mis => mis_bsdf(v, u.bsdf),
+        Strategy::Mis => mis_bsdf(v, u.bsdf, cosine),
+    }
+}
+
+/// Whether `strategy` scatters from a diffuse vertex by cosine sampling, whose
+/// directions a wave draws in lanes ([`CosineDraws`]).
+pub(crate) fn scatters_by_cosine(strategy: Strategy) -> bool {
+    match strategy {
+        Strategy::Cosine => true,
+        Strategy::Mis => MIS_HEMISPHERE == HemisphereSampling::Cosine,
+        Strategy::Uniform | Strategy::Light | Strategy::Mixture => false,
+    }
+}
+
+/// The cosine-weighted local directions a wave's diffuse vertices scatter by, drawn
+/// together, a request per lane ([`sample_cosine_hemisphere_lanes`]): each is the bits
+/// `sample_cosine_hemisphere` gives for its numbers alone, whatever its company and the
+/// SIMD level. One is a chain of a division, a sine and cosine, and a square root, which
+/// the shading of its vertex waited on; in lanes, a vector of them costs about what one
+/// does.
+#[derive(Debug, Default)]
+pub(crate) struct CosineDraws {
+    /// Per request, its two numbers, padded with zeros to whole vectors when drawn.
+    u0: Vec<f32>,
+    u1: Vec<f32>,
+    /// Per request, after [`CosineDraws::draw`]: its direction.
+    pub drawn: Vec<Vec3>,
+}
+
+impl CosineDraws {
+    pub fn clear(&mut self) {
+        self.u0.clear();
+        self.u1.clear();
+        self.drawn.clear();
+    }
+
+    /// Asks for the direction of `u`; its index in `drawn`.
+    pub fn request(&mut self, u: Vec2) -> usize {
+        self.u0.push(u.x);
+        self.u1.push(u.y);
+        self.u0.len() - 1
+    }
+
+    /// Draws every request's direction on `level` (the widest available where it is not).
+    pub fn draw(&mut self, level: SimdLevel) {
+        self.drawn.clear();
+        let n = self.u0.len();
+        if n == 0 {
+            return;
+        }
+        // Whole vectors of the widest level, so that every load is of a known length.
+        let padded = n.next_multiple_of(MAX_LANES);
+        self.u0.resize(padded, 0.0);
+        self.u1.resize(padded, 0.0);
+        // The level is available: `or_widest` says so.
+        let _ = level.or_widest().dispatch(DrawCosines {
+            u: [&self.u0, &self.u1],
+            n,
+            drawn: &mut self.drawn,
+        });
+    }
+}
+
+/// The kernel of [`CosineDraws::draw`].
+struct DrawCosines<'a> {
+    u: [&'a [f32]; 2],
+    n: usize,
+    drawn: &'a mut Vec<Vec3>,
+}
+
+impl LaneKernel for DrawCosines<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let DrawCosines {
+            u: [u0, u1],
+            n,
+            drawn,
+        } = self;
+        let width = L::LANES.min(MAX_LANES);
+        let mut out = [[0f32; MAX_LANES]; 3];
+        for start in (0..n).step_by(width) {
+            let lanes = start..start + width;
+            let d =
+                sample_cosine_hemisphere_lanes([L::load(&u0[lanes.clone()]), L::load(&u1[lanes])]);
+            for (row, v) in out.iter_mut().zip([d.x, d.y, d.z]) {
+                v.store(&mut row[..width]);
+            }
+            drawn.extend(
+                (0..width.min(n - start)).map(|k| Vec3::new(out[0][k], out[1][k], out[2][k])),
+            );
+        }
     }
 }
 
@@ -165,8 +259,15 @@ pub(crate) fn uses_next_event(strategy: Strategy) -> bool {
 
 /// `uniform` and `cosine`: BSDF sampling over the hemisphere; emission found
 /// later counts in full.
-pub(crate) fn hemisphere(v: &Vertex, hemisphere: HemisphereSampling, u: Vec2) -> Option<Scatter> {
-    let s = v.material.sample(v.wo, v.at.n, u, hemisphere)?;
+pub(crate) fn hemisphere(
+    v: &Vertex,
+    hemisphere: HemisphereSampling,
+    u: Vec2,
+    drawn: Option<Vec3>,
+) -> Option<Scatter> {
+    let s = v
+        .material
+        .sample_drawn(v.wo, v.at.n, u, hemisphere, drawn)?;
     Some(Scatter {
         wi: s.wi,
         weight: s.weight(v.at.n),
@@ -224,8 +325,10 @@ pub(crate) fn mixture_pdf(emitters: &Emitters<'_>, v: &Vertex, wi: Vec3) -> f32 
 /// `mis`'s BSDF half: cosine sampling, with emission found along it weighted
 /// against next-event estimation ([`Lighting::next_event`] is the other
 /// half).
-pub(crate) fn mis_bsdf(v: &Vertex, u: Vec2) -> Option<Scatter> {
-    let s = v.material.sample(v.wo, v.at.n, u, MIS_HEMISPHERE)?;
+pub(crate) fn mis_bsdf(v: &Vertex, u: Vec2, drawn: Option<Vec3>) -> Option<Scatter> {
+    let s = v
+        .material
+        .sample_drawn(v.wo, v.at.n, u, MIS_HEMISPHERE, drawn)?;
     Some(Scatter {
         wi: s.wi,
         weight: s.weight(v.at.n),
@@ -456,6 +559,29 @@ mod tests {
         assert!(test.accepts(SIGNIFICANCE), "{name}: {test:?}");
     }
 
+    /// A wave's cosine directions drawn in lanes are the bits each gets alone, on every
+    /// SIMD level and for any number of requests (a short last vector included), at the
+    /// ends of the square and its centre too.
+    #[test]
+    fn cosine_draws_are_each_sample_alone() {
+        let mut u = uniforms(9);
+        let mut requests: Vec<Vec2> = (0..37).map(|_| Vec2::new(u(), u())).collect();
+        let ends = [0.0, 0.5, lueur_sampling::ONE_MINUS_EPSILON];
+        requests.extend(ends.iter().flat_map(|&a| ends.map(|b| Vec2::new(a, b))));
+        for level in SimdLevel::available() {
+            for n in [1, 7, 16, 17, requests.len()] {
+                let mut draws = CosineDraws::default();
+                let indices: Vec<usize> = requests[..n].iter().map(|&u| draws.request(u)).collect();
+                draws.draw(level);
+                assert_eq!(draws.drawn.len(), n);
+                for (&k, &u) in indices.iter().zip(&requests) {
+                    let alone = lueur_sampling::sample_cosine_hemisphere(u);
+                    assert_eq!(draws.drawn[k], alone, "{level:?}, {n} requests, u = {u}");
+                }
+            }
+        }
+    }
+
     fn reported(s: Scatter) -> (Vec3, f32) {
         (s.wi, s.pdf)
     }
@@ -468,7 +594,7 @@ mod tests {
             (1, Strategy::Uniform, HemisphereSampling::Uniform),
             (2, Strategy::Cosine, HemisphereSampling::Cosine),
         ] {
-            let sample = |u: &VertexSample| scatter(strategy, &emitters, &v, u).map(reported);
+            let sample = |u: &VertexSample| scatter(strategy, &emitters, &v, u, None).map(reported);
             let pdf = |wi| v.material.pdf(v.wo, wi, v.at.n, hemisphere);
             check(strategy.name(), seed, sample, pdf);
         }
@@ -481,7 +607,7 @@ mod tests {
             let scene = scene(true);
             let emitters = scene.emitters(quads);
             let sample =
-                |u: &VertexSample| scatter(Strategy::Light, &emitters, &v, u).map(reported);
+                |u: &VertexSample| scatter(Strategy::Light, &emitters, &v, u, None).map(reported);
             let pdf = |wi| emitters.pdf(v.at.p, v.at.n, wi);
             check(&format!("light, {quads:?}"), seed, sample, pdf);
         }
@@ -494,7 +620,7 @@ mod tests {
             let scene = scene(sky);
             let emitters = scene.emitters(QuadSampling::SolidAngle);
             let sample =
-                |u: &VertexSample| scatter(Strategy::Mixture, &emitters, &v, u).map(reported);
+                |u: &VertexSample| scatter(Strategy::Mixture, &emitters, &v, u, None).map(reported);
             let pdf = |wi| mixture_pdf(&emitters, &v, wi);
             check(&format!("mixture, sky {sky}"), seed, sample, pdf);
         }
@@ -510,7 +636,7 @@ mod tests {
         let (v, scene) = (vertex(), scene(true));
         let emitters = scene.emitters(QuadSampling::SolidAngle);
         let bsdf = |u: &VertexSample| {
-            let s = scatter(Strategy::Mis, &emitters, &v, u)?;
+            let s = scatter(Strategy::Mis, &emitters, &v, u, None)?;
             assert_eq!(
                 s.emission,
                 EmissionWeight::PowerHeuristic { bsdf_pdf: s.pdf }

@@ -136,13 +136,36 @@ impl Material {
         u: Vec2,
         hemisphere: HemisphereSampling,
     ) -> Option<BsdfSample> {
+        self.sample_drawn(wo, n, u, hemisphere, None)
+    }
+
+    /// [`Material::sample`], where the cosine-weighted local direction was `drawn`
+    /// already from `u` (`sample_cosine_hemisphere(u)`, or its lanes form for a batch
+    /// of vertices); used only by [`HemisphereSampling::Cosine`] on a diffuse lobe.
+    /// Always inlined: out of line, its vectors arrived through memory, stored in
+    /// pieces and loaded whole, and the loads waited for the stores.
+    #[inline(always)]
+    pub fn sample_drawn(
+        &self,
+        wo: Vec3,
+        n: Vec3,
+        u: Vec2,
+        hemisphere: HemisphereSampling,
+        drawn: Option<Vec3>,
+    ) -> Option<BsdfSample> {
         // Scatter on the side `wo` is on: surfaces are two-sided.
         let n = if n.dot(wo) < 0.0 { -n } else { n };
         match *self {
             Material::Lambertian { albedo } => {
                 let local = match hemisphere {
                     HemisphereSampling::Uniform => sample_uniform_hemisphere(u),
-                    HemisphereSampling::Cosine => sample_cosine_hemisphere(u),
+                    HemisphereSampling::Cosine => match drawn {
+                        Some(local) => {
+                            debug_assert_eq!(local, sample_cosine_hemisphere(u));
+                            local
+                        }
+                        None => sample_cosine_hemisphere(u),
+                    },
                 };
                 let pdf = match hemisphere {
                     HemisphereSampling::Uniform => uniform_hemisphere_pdf(),

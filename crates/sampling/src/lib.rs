@@ -95,7 +95,7 @@ pub use sphere_light::{
 pub use warp::{
     cosine_hemisphere_pdf, invert_cosine_hemisphere, invert_uniform_cone,
     invert_uniform_disk_concentric, invert_uniform_hemisphere, invert_uniform_sphere,
-    sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_disk_concentric,
-    sample_uniform_hemisphere, sample_uniform_sphere, uniform_cone_pdf, uniform_disk_pdf,
-    uniform_hemisphere_pdf, uniform_sphere_pdf,
+    sample_cosine_hemisphere, sample_cosine_hemisphere_lanes, sample_uniform_cone,
+    sample_uniform_disk_concentric, sample_uniform_hemisphere, sample_uniform_sphere,
+    uniform_cone_pdf, uniform_disk_pdf, uniform_hemisphere_pdf, uniform_sphere_pdf,
 };

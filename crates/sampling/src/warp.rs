@@ -29,16 +29,32 @@ fn azimuth_to_u(x: f32, y: f32) -> f32 {
 /// mapping (pbrt-v4 §A.5.1, `SampleUniformDiskConcentric`), which keeps
 /// strata compact and is continuous, unlike the polar mapping.
 pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
-    let offset = 2.0 * clamp_u2(u) - Vec2::ONE;
-    if offset == Vec2::ZERO {
-        return Vec2::ZERO;
-    }
-    let (r, theta) = if offset.x.abs() > offset.y.abs() {
-        (offset.x, FRAC_PI_4 * (offset.y / offset.x))
-    } else {
-        (offset.y, FRAC_PI_2 - FRAC_PI_4 * (offset.x / offset.y))
-    };
-    r * Vec2::new(theta.cos(), theta.sin())
+    let [x, y] = sample_uniform_disk_concentric_lanes([u.x, u.y]);
+    Vec2::new(x, y)
+}
+
+/// [`sample_uniform_disk_concentric`] per lane, its one definition: the wedge chosen by
+/// selects and the angle's sine and cosine by the polynomial of `math.rs`, so that a wave
+/// of BSDF samples is drawn in lanes with the bits one sample alone gets.
+#[inline(always)]
+fn sample_uniform_disk_concentric_lanes<L: Lane>([u0, u1]: [L; 2]) -> [L; 2] {
+    let (zero, one, two) = (L::splat(0.0), L::splat(1.0), L::splat(2.0));
+    let x = two * clamp_u_lanes(u0) - one;
+    let y = two * clamp_u_lanes(u1) - one;
+    // The wedge of the larger coordinate, which is the radius; the angle in turns
+    // (pi/4 is 1/8) from the ratio of the smaller to it, folded into [0, 1).
+    let x_wedge = x.abs().gt(y.abs());
+    let r = L::select(x_wedge, x, y);
+    let ratio = L::select(x_wedge, y, x) / r;
+    let eighth = L::splat(0.125);
+    let turns = L::select(x_wedge, eighth * ratio, L::splat(0.25) - eighth * ratio);
+    let (sin, cos) = sin_cos_turns(L::select(turns.lt(zero), turns + one, turns));
+    // The centre (0 / 0 above) maps to itself.
+    let centre = L::not(r.abs().gt(zero));
+    [
+        L::select(centre, zero, r * cos),
+        L::select(centre, zero, r * sin),
+    ]
 }
 
 /// Inverse of [`sample_uniform_disk_concentric`] (pbrt-v4 §A.5.1,
@@ -100,9 +116,15 @@ pub fn invert_uniform_hemisphere(w: Vec3) -> Vec2 {
 /// lift a concentric disk sample onto the hemisphere (pbrt-v4 §A.5.3). The
 /// sample can land exactly on the horizon (`z = 0`), where the pdf is 0.
 pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let d = sample_uniform_disk_concentric(u);
-    let z = safe_sqrt(1.0 - d.x * d.x - d.y * d.y);
-    Vec3::new(d.x, d.y, z)
+    sample_cosine_hemisphere_lanes([u.x, u.y]).into()
+}
+
+/// [`sample_cosine_hemisphere`] per lane, its one definition.
+#[inline(always)]
+pub fn sample_cosine_hemisphere_lanes<L: Lane>(u: [L; 2]) -> LaneVec3<L> {
+    let [x, y] = sample_uniform_disk_concentric_lanes(u);
+    let z = safe_sqrt_lanes(L::splat(1.0) - x * x - y * y);
+    LaneVec3::new(x, y, z)
 }
 
 /// Solid-angle pdf of [`sample_cosine_hemisphere`]: `max(cos_theta, 0) / pi`
