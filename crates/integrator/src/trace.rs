@@ -263,11 +263,11 @@ impl PreparedScene {
             // queues, it made every ray wait for its stores (docs/PERFORMANCE.md, "Stores
             // loaded whole").
             let done = if inside {
-                let p = p;
-                Some((sphere_trace(&self.geometry.inside(), &r.ray, &p), None))
+                let copy = p;
+                Some((sphere_trace(&self.geometry.inside(), &r.ray, &copy), None))
             } else if tracing.marching == Marching::Naive {
-                let p = p;
-                Some(self.geometry.trace_naive(&r.ray, &p))
+                let copy = p;
+                Some(self.geometry.trace_naive(&r.ray, &copy))
             } else {
                 scratch.batch.queue(i, r.ray, p);
                 None
@@ -360,8 +360,8 @@ impl PreparedScene {
             let p = TraceParams { t_max, ..params };
             match tracing.marching {
                 Marching::Naive => {
-                    let p = p;
-                    let outcome = self.geometry.trace_naive(&r.ray, &p).0;
+                    let copy = p;
+                    let outcome = self.geometry.trace_naive(&r.ray, &copy).0;
                     counters.record(&outcome);
                     free[i] = matches!(outcome, TraceOutcome::Miss { .. });
                 }
