@@ -107,6 +107,7 @@ struct Path {
 /// A path shaded at a vertex, waiting for its shadow rays: the vertex, the shadow rays'
 /// contributions (`shadow` indexes the wave's shadow rays; the next-event ray, if any, is
 /// the last), and where the path goes next.
+#[derive(Clone, Copy)]
 struct Shaded {
     path: usize,
     surface: SurfacePoint,
@@ -115,6 +116,19 @@ struct Shaded {
     next_event: bool,
     scatter: Option<Scatter>,
     roulette: f32,
+}
+
+impl Shaded {
+    /// A placeholder for a slot that [`shade`] fills.
+    const UNSET: Shaded = Shaded {
+        path: 0,
+        surface: SurfacePoint::UNSET,
+        diffuse: false,
+        shadow: (0, 0),
+        next_event: false,
+        scatter: None,
+        roulette: 0.0,
+    };
 }
 
 /// A vertex waiting to be shaded: its path, where it is, its numbers, its sphere-light
@@ -173,7 +187,8 @@ fn shade(
     (pending, path): (&Pending, &Path),
     (spheres, cosines): (&SphereDraws, &CosineDraws),
     shadow: &mut ShadowQueue,
-) -> Shaded {
+    out: &mut Shaded,
+) {
     let Estimator {
         scene, settings, ..
     } = *estimator;
@@ -191,9 +206,19 @@ fn shade(
         wo: -path.ray.dir,
         material,
     };
+    // Written into its slot a field at a time, as it is made: made whole and pushed, the
+    // scatter and then the whole record were stored in pieces and loaded back whole, and
+    // the loads waited for the stores (docs/PERFORMANCE.md, "Stores loaded whole").
+    out.path = index;
+    out.surface = surface;
+    out.roulette = u.roulette;
     let first = shadow.rays.len();
-    let (diffuse, next_event, scatter) = match material {
-        Material::Mirror { .. } => (false, false, strategy::mirror(&vertex, u.bsdf)),
+    match material {
+        Material::Mirror { .. } => {
+            out.diffuse = false;
+            out.next_event = false;
+            out.scatter = strategy::mirror(&vertex, u.bsdf);
+        }
         Material::Lambertian { .. } => {
             shadow.lights.clear();
             lighting.delta_lights(&vertex, &mut shadow.lights);
@@ -204,7 +229,8 @@ fn shade(
             // Pushed where it is made: moved through an `Option` and an iterator chain,
             // the ray was stored in pieces and loaded whole, and the load waited for the
             // stores.
-            let next_event = strategy::uses_next_event(settings.strategy)
+            out.diffuse = true;
+            out.next_event = strategy::uses_next_event(settings.strategy)
                 && match lighting.next_event(&vertex, u, sphere.map(|k| spheres.drawn[k])) {
                     Some((ray, contribution)) => {
                         shadow.rays.push(ray);
@@ -214,20 +240,11 @@ fn shade(
                     None => false,
                 };
             let cosine = cosine.map(|k| cosines.drawn[k]);
-            let scatter =
+            out.scatter =
                 strategy::scatter(settings.strategy, &lighting.emitters, &vertex, u, cosine);
-            (true, next_event, scatter)
         }
-    };
-    Shaded {
-        path: index,
-        surface,
-        diffuse,
-        shadow: (first, shadow.rays.len()),
-        next_event,
-        scatter,
-        roulette: u.roulette,
     }
+    out.shadow = (first, shadow.rays.len());
 }
 
 /// Radiance arriving along each of `camera_rays` (sample `ids[i]` for ray `i`, its numbers
@@ -345,18 +362,19 @@ pub(crate) fn radiance_wave(
         s.spheres.draw(tracing.simd);
         s.cosines.draw(tracing.simd);
 
-        s.shaded.clear();
+        s.shaded.resize(s.pending.len(), Shaded::UNSET);
         s.shadow.rays.clear();
         s.shadow.contributions.clear();
-        for pending in &s.pending {
+        for (pending, out) in s.pending.iter().zip(&mut s.shaded) {
             let path = &s.paths[pending.path];
-            s.shaded.push(shade(
+            shade(
                 estimator,
                 &lighting,
                 (pending, path),
                 (&s.spheres, &s.cosines),
                 &mut s.shadow,
-            ));
+                out,
+            );
         }
         scene.unoccluded_rays(
             &s.shadow.rays,

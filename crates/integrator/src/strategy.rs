@@ -325,6 +325,10 @@ pub(crate) fn mixture_pdf(emitters: &Emitters<'_>, v: &Vertex, wi: Vec3) -> f32 
 /// `mis`'s BSDF half: cosine sampling, with emission found along it weighted
 /// against next-event estimation ([`Lighting::next_event`] is the other
 /// half).
+///
+/// Always inlined, as [`Material::sample_drawn`] is: out of line, its result came back
+/// through memory, stored in pieces and loaded whole.
+#[inline(always)]
 pub(crate) fn mis_bsdf(v: &Vertex, u: Vec2, drawn: Option<Vec3>) -> Option<Scatter> {
     let s = v
         .material

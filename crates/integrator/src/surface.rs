@@ -458,8 +458,8 @@ impl SurfacePoint {
         }
     }
 
-    /// A placeholder for a slot that [`SurfacePoint::at_hits`] fills.
-    const UNSET: SurfacePoint = SurfacePoint {
+    /// A placeholder for a slot about to be filled.
+    pub(crate) const UNSET: SurfacePoint = SurfacePoint {
         p: Vec3::ZERO,
         n: Vec3::ZERO,
         origin: Vec3::ZERO,
