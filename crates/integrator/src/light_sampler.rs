@@ -214,7 +214,9 @@ impl SphereDraws {
     }
 
     /// Asks for a sample of the sphere `(center, radius)` from `p` with `u`; its index in
-    /// `drawn`.
+    /// `drawn`. Inlined: out of line, its vectors arrived through memory, stored in
+    /// pieces and loaded whole, and the loads waited for the stores.
+    #[inline(always)]
     pub fn request(&mut self, p: Vec3, (center, radius): (Vec3, f32), u: Vec2) -> usize {
         self.requests.push([
             p.x, p.y, p.z, center.x, center.y, center.z, radius, u.x, u.y,
