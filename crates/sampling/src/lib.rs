@@ -21,8 +21,11 @@
 //! routine is written once over `lueur-sdf-math`'s `Lane` number type (one
 //! `f32`, or a SIMD vector of them), and the scalar function is its one-lane
 //! instance: [`sample_sphere_light_lanes`] gives, in every lane, the bits
-//! [`sample_sphere_light`] gives. Its azimuth's sine and cosine are our own
-//! polynomial (`math.rs`), not libm's, which has no vector form to match.
+//! [`sample_sphere_light`] gives, and [`sample_cosine_hemisphere_lanes`] those of
+//! [`sample_cosine_hemisphere`]. Their sines and cosines are our own polynomial
+//! (`math.rs`), not libm's, which has no vector form to match. The spherical
+//! rectangle, scalar and in f64, takes its `atan2` and `sincos` from the `libm`
+//! crate, which gives the same bits on every platform.
 //!
 //! **Contract.** Every warp's samples follow its pdf (checked by chi-square
 //! goodness-of-fit tests); every pdf is finite and `>= 0`; no NaN or infinity
