@@ -214,8 +214,8 @@ impl SphereDraws {
     }
 
     /// Asks for a sample of the sphere `(center, radius)` from `p` with `u`; its index in
-    /// `drawn`. Inlined: out of line, its vectors arrived through memory, stored in
-    /// pieces and loaded whole, and the loads waited for the stores.
+    /// `drawn`. Inlined: out of line, its vectors pass through memory, stored in pieces
+    /// and loaded whole, and each load waits for its stores to retire.
     #[inline(always)]
     pub fn request(&mut self, p: Vec3, (center, radius): (Vec3, f32), u: Vec2) -> usize {
         self.requests.push([

@@ -206,9 +206,9 @@ fn shade(
         wo: -path.ray.dir,
         material,
     };
-    // Written into its slot a field at a time, as it is made: made whole and pushed, the
-    // scatter and then the whole record were stored in pieces and loaded back whole, and
-    // the loads waited for the stores (docs/PERFORMANCE.md, "Stores loaded whole").
+    // Written into its slot a field at a time, as it is made: a record made whole and then
+    // pushed is stored in pieces and loaded back whole, and the load waits for the stores
+    // to retire (docs/PERFORMANCE.md, "Stores loaded whole").
     out.path = index;
     out.surface = surface;
     out.roulette = u.roulette;
@@ -226,10 +226,10 @@ fn shade(
                 shadow.rays.push(ray);
                 shadow.contributions.push(contribution);
             }
-            // Pushed where it is made: moved through an `Option` and an iterator chain,
-            // the ray was stored in pieces and loaded whole, and the load waited for the
-            // stores.
             out.diffuse = true;
+            // Pushed where it is made: moved through an `Option` and an iterator chain,
+            // the ray is stored in pieces and loaded whole, and the load waits for the
+            // stores.
             out.next_event = strategy::uses_next_event(settings.strategy)
                 && match lighting.next_event(&vertex, u, sphere.map(|k| spheres.drawn[k])) {
                     Some((ray, contribution)) => {
@@ -287,8 +287,8 @@ pub(crate) fn radiance_wave(
     s.active.clear();
     s.active.extend(0..s.paths.len());
     while !s.active.is_empty() {
-        // Field by field into place: a `PathRay` made whole first was written in pieces on
-        // the stack and loaded back whole, and every ray waited for its stores
+        // Field by field into place: a `PathRay` made whole first is written in pieces on
+        // the stack and loaded back whole, and every ray waits for its stores
         // (docs/PERFORMANCE.md, "Stores loaded whole").
         s.rays.resize(s.active.len(), PathRay::UNSET);
         for (ray, &i) in s.rays.iter_mut().zip(&s.active) {

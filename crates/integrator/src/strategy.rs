@@ -168,8 +168,8 @@ pub(crate) fn scatters_by_cosine(strategy: Strategy) -> bool {
 /// together, a request per lane ([`sample_cosine_hemisphere_lanes`]): each is the bits
 /// `sample_cosine_hemisphere` gives for its numbers alone, whatever its company and the
 /// SIMD level. One is a chain of a division, a sine and cosine, and a square root, which
-/// the shading of its vertex waited on; in lanes, a vector of them costs about what one
-/// does.
+/// the shading of its vertex would wait on; in lanes, a vector of them costs about what
+/// one does.
 #[derive(Debug, Default)]
 pub(crate) struct CosineDraws {
     /// Per request, its two numbers, padded with zeros to whole vectors when drawn.
@@ -326,7 +326,7 @@ pub(crate) fn mixture_pdf(emitters: &Emitters<'_>, v: &Vertex, wi: Vec3) -> f32 
 /// against next-event estimation ([`Lighting::next_event`] is the other
 /// half).
 ///
-/// Always inlined, as [`Material::sample_drawn`] is: out of line, its result came back
+/// Always inlined, as [`Material::sample_drawn`] is: out of line, its result comes back
 /// through memory, stored in pieces and loaded whole.
 #[inline(always)]
 pub(crate) fn mis_bsdf(v: &Vertex, u: Vec2, drawn: Option<Vec3>) -> Option<Scatter> {

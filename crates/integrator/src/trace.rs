@@ -260,7 +260,7 @@ impl PreparedScene {
             }
             // The rare paths take a copy by reference, so that `p` itself stays in
             // registers: built in memory a field at a time and copied whole into the
-            // queues, it made every ray wait for its stores (docs/PERFORMANCE.md, "Stores
+            // queues, it makes every ray wait for its stores (docs/PERFORMANCE.md, "Stores
             // loaded whole").
             let done = if inside {
                 let copy = p;
@@ -292,7 +292,7 @@ impl PreparedScene {
     }
 
     /// The surface a march of `ray` with parameters `params` found, if any. Inlined: its
-    /// result, returned through memory, was loaded whole before its stores had retired.
+    /// result, returned through memory, is loaded whole before its stores retire.
     #[inline(always)]
     fn surface_hit(
         &self,

@@ -142,8 +142,8 @@ impl Material {
     /// [`Material::sample`], where the cosine-weighted local direction was `drawn`
     /// already from `u` (`sample_cosine_hemisphere(u)`, or its lanes form for a batch
     /// of vertices); used only by [`HemisphereSampling::Cosine`] on a diffuse lobe.
-    /// Always inlined: out of line, its vectors arrived through memory, stored in
-    /// pieces and loaded whole, and the loads waited for the stores.
+    /// Always inlined: out of line, its vectors pass through memory, stored in pieces
+    /// and loaded whole, and each load waits for its stores to retire.
     #[inline(always)]
     pub fn sample_drawn(
         &self,
