@@ -5,8 +5,8 @@
 
 use glam::{Vec2, Vec3};
 use lueur_sampling::{
-    DirectionSample, DiscreteDistribution, Frame, cosine_hemisphere_pdf, sample_cosine_hemisphere,
-    sample_sphere_light_lanes,
+    DirectionSample, DiscreteDistribution, Frame, RectangleFrame, cosine_hemisphere_pdf,
+    sample_cosine_hemisphere, sample_sphere_light_lanes,
 };
 use lueur_sdf_math::{Lane, LaneKernel, LaneVec3, MAX_LANES, SimdLevel, write_lane};
 
@@ -29,6 +29,8 @@ pub(crate) struct LightSampler {
     choice: Option<DiscreteDistribution>,
     /// Whether any emitter is a sphere light.
     spheres: bool,
+    /// Per light, its [`Light::rectangle_frame`]: made once here, not at every sample.
+    rectangles: Vec<Option<RectangleFrame>>,
 }
 
 impl LightSampler {
@@ -50,6 +52,7 @@ impl LightSampler {
             emitters,
             choice,
             spheres,
+            rectangles: lights.iter().map(Light::rectangle_frame).collect(),
         }
     }
 
@@ -146,6 +149,7 @@ impl Emitters<'_> {
                 ))
             }
             Emitter::Light(i) => {
+                let drawn = drawn.or_else(|| self.rectangle(i).map(|frame| frame.sample(p, u)));
                 let s = self.lights[i].sample_drawn(p, u, self.quad_sampling, drawn)?;
                 Some((
                     EmitterSample {
@@ -189,7 +193,20 @@ impl Emitters<'_> {
     fn single_pdf(&self, e: Emitter, p: Vec3, n: Vec3, wi: Vec3) -> f32 {
         match e {
             Emitter::Sky => cosine_hemisphere_pdf(n.dot(wi)),
-            Emitter::Light(i) => self.lights[i].pdf(p, wi, self.quad_sampling),
+            Emitter::Light(i) => match self.rectangle(i) {
+                Some(frame) => frame.pdf(p, wi),
+                None => self.lights[i].pdf(p, wi, self.quad_sampling),
+            },
+        }
+    }
+
+    /// Light `i`'s frame where it is a rectangle sampled by solid angle: then its
+    /// samples and pdfs are the frame's ([`Light::rectangle_frame`]).
+    #[inline]
+    fn rectangle(&self, i: usize) -> Option<&RectangleFrame> {
+        match self.quad_sampling {
+            QuadSampling::SolidAngle => self.sampler.rectangles[i].as_ref(),
+            QuadSampling::Area => None,
         }
     }
 }

@@ -243,7 +243,7 @@ impl PreparedScene {
                 origin: r.from,
                 dir: r.ray.dir,
             };
-            let light_hit = self.intersect_lights(&light_ray, params.t_max, None);
+            let light_hit = self.intersect_lights(light_ray, params.t_max, None);
             hits.push(light_hit.map(|(t, light)| Hit::Light { t, light }));
             let p = TraceParams {
                 t_max: light_hit.map_or(params.t_max, |(t, _)| t),
@@ -351,7 +351,7 @@ impl PreparedScene {
             // lights that are objects too) does not occlude it.
             let t_max = (r.distance * (1.0 - 1e-4) - params.eps_abs).min(params.t_max);
             let blocked = self
-                .intersect_lights(&r.ray, t_max, r.target)
+                .intersect_lights(r.ray, t_max, r.target)
                 .is_some_and(|(_, l)| Some(l) != r.target);
             free.push(!blocked);
             if blocked || self.scene().objects.is_empty() || t_max <= params.t_min {
@@ -377,13 +377,17 @@ impl PreparedScene {
         counters.timed(clock);
     }
 
-    fn intersect_lights(&self, ray: &Ray, t_max: f32, skip: Option<usize>) -> Option<(f32, usize)> {
+    /// The nearest light `ray` meets before `t_max`, other than `skip`. The ray by value
+    /// and the lights' tests inlined: a ray passed by reference is stored in pieces and
+    /// loaded whole, and the load waits for the stores to retire.
+    #[inline(always)]
+    fn intersect_lights(&self, ray: Ray, t_max: f32, skip: Option<usize>) -> Option<(f32, usize)> {
         let mut best: Option<(f32, usize)> = None;
         for (i, l) in self.scene().lights.iter().enumerate() {
             if Some(i) == skip {
                 continue;
             }
-            let t = l.intersect(ray);
+            let t = l.intersect(&ray);
             if let Some(t) = t
                 && t < t_max
                 && best.is_none_or(|(bt, _)| t < bt)

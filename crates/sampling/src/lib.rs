@@ -87,8 +87,8 @@ pub use light::{DirectionSample, DirectionSampleLanes};
 pub use math::ONE_MINUS_EPSILON;
 pub use mis::{balance_heuristic, power_heuristic};
 pub use quad_light::{
-    SphericalRectangle, polygon_irradiance, quad_area_pdf, quad_solid_angle_pdf, sample_quad_area,
-    sample_quad_solid_angle,
+    RectangleFrame, SphericalRectangle, polygon_irradiance, quad_area_pdf, quad_solid_angle_pdf,
+    sample_quad_area, sample_quad_solid_angle,
 };
 pub use sampler::{DIMENSIONS_PER_SAMPLE, Sampler};
 pub use sampler_kind::SamplerKind;

@@ -5,7 +5,7 @@
 
 use glam::{Vec2, Vec3};
 use lueur_sampling::{
-    DirectionSample, quad_area_pdf, quad_solid_angle_pdf, sample_quad_area,
+    DirectionSample, RectangleFrame, quad_area_pdf, quad_solid_angle_pdf, sample_quad_area,
     sample_quad_solid_angle, sample_sphere_light, sphere_light_pdf,
 };
 use lueur_sdf_math::Ray;
@@ -127,6 +127,7 @@ impl Light {
 
     /// Where `ray` first meets the light's surface (lights at infinity are
     /// never met).
+    #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
         match *self {
             Light::Sphere { center, radius, .. } => ray_sphere(ray, center, radius),
@@ -197,9 +198,27 @@ impl Light {
         }
     }
 
-    /// [`Light::sample`], where a sphere light's direction sample may have been `drawn`
-    /// already, by [`lueur_sampling::sample_sphere_light`] or its batch form, from `p`
-    /// with `u` (`None`: draw it here; other lights always draw their own).
+    /// A rectangular quad light's [`RectangleFrame`]: the part of its solid-angle sampling
+    /// that does not depend on the shading point, for a renderer to make once. Under
+    /// [`QuadSampling::SolidAngle`], its [`RectangleFrame::sample`] and
+    /// [`RectangleFrame::pdf`] give what [`Light::sample`] and [`Light::pdf`] do. `None`
+    /// for any other light.
+    pub fn rectangle_frame(&self) -> Option<RectangleFrame> {
+        match *self {
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                ..
+            } if is_rectangle(edge_u, edge_v) => RectangleFrame::new(corner, edge_u, edge_v),
+            Light::Quad { .. } | Light::Sphere { .. } | Light::Directional { .. } => None,
+        }
+    }
+
+    /// [`Light::sample`], where the direction sample may have been `drawn` already from
+    /// `p` with `u`: a sphere light's by [`lueur_sampling::sample_sphere_light`] or its
+    /// batch form, a rectangle's by its [`Light::rectangle_frame`] (`None`: draw it here;
+    /// a delta light has none).
     #[inline]
     pub fn sample_drawn(
         &self,
@@ -230,13 +249,14 @@ impl Light {
                 edge_v,
                 radiance,
             } => {
-                let s = match quad_sampling {
-                    QuadSampling::SolidAngle if is_rectangle(edge_u, edge_v) => {
+                let s = match (drawn, quad_sampling) {
+                    (Some(s), _) => s?,
+                    (None, QuadSampling::SolidAngle) if is_rectangle(edge_u, edge_v) => {
                         // Falls back to area sampling where the solid angle is
                         // too small for the spherical-rectangle warp's f32 math.
                         sample_quad_solid_angle(p, corner, edge_u, edge_v, u)?
                     }
-                    _ => sample_quad_area(p, corner, edge_u, edge_v, u)?,
+                    (None, _) => sample_quad_area(p, corner, edge_u, edge_v, u)?,
                 };
                 (s, radiance)
             }
@@ -298,6 +318,7 @@ fn is_rectangle(edge_u: Vec3, edge_v: Vec3) -> bool {
 /// Nearest positive intersection of a ray with a sphere (from outside or
 /// inside). Uses the numerically stable form of pbrt-v4 (section 6.8.1):
 /// the discriminant from `|o - c - (b) d|` avoids cancellation far away.
+#[inline]
 pub(crate) fn ray_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<f32> {
     let oc = ray.origin - center;
     let b = oc.dot(ray.dir);
@@ -329,6 +350,7 @@ pub(crate) fn ray_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<f32> {
 }
 
 /// Intersection of a ray with the parallelogram `corner + s eu + t ev`.
+#[inline]
 pub(crate) fn ray_quad(ray: &Ray, corner: Vec3, edge_u: Vec3, edge_v: Vec3) -> Option<f32> {
     let n = edge_u.cross(edge_v);
     let denom = n.dot(ray.dir);
@@ -383,5 +405,76 @@ mod tests {
         assert!(ray_quad(&off, c, u, v).is_none());
         let down = Ray::new(Vec3::ZERO, -Vec3::Y);
         assert!(ray_quad(&down, c, u, v).is_none());
+    }
+
+    /// A renderer that makes each rectangle's frame once and draws through it gets what
+    /// the light itself gives, bit for bit: the same samples, the same pdfs, and, where it
+    /// passes the drawn sample back, the same emitter samples. Lights that are not
+    /// rectangles (sampled by area) have no frame.
+    #[test]
+    fn rectangle_frames_sample_as_their_lights_do() {
+        let quad = |corner: Vec3, edge_u: Vec3, edge_v: Vec3| Light::Quad {
+            corner,
+            edge_u,
+            edge_v,
+            radiance: Vec3::ONE,
+        };
+        let rectangles = [
+            quad(
+                Vec3::new(-0.3, 2.2, -0.3),
+                Vec3::new(0.6, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, 0.6),
+            ),
+            // Tilted, long and thin, a 1 mm light 1 km away from some points.
+            quad(
+                Vec3::new(1.0, 3.0, 2.0),
+                Vec3::new(0.0, 0.6, 0.8),
+                Vec3::new(-5.0, 0.0, 0.0),
+            ),
+            quad(
+                Vec3::new(0.0, 1.0, 0.0),
+                Vec3::new(1e-3, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, -1e-3),
+            ),
+        ];
+        let points = [
+            Vec3::ZERO,
+            Vec3::new(0.1, 2.2 - 1e-6, 0.05),
+            Vec3::new(0.0, 2.2, 0.0),
+            Vec3::new(3.0, 5.0, -1.0),
+            Vec3::new(-1e3, -1e3, 1e3),
+            Vec3::new(0.0, -1e3, 0.0),
+        ];
+        let us = [Vec2::ZERO, Vec2::new(0.3, 0.7), Vec2::new(0.999_999_9, 0.5)];
+        let mut framed = 0;
+        for light in rectangles {
+            let frame = light.rectangle_frame().expect("a rectangle has a frame");
+            for p in points {
+                for u in us {
+                    let drawn = frame.sample(p, u);
+                    let sample = light.sample(p, u, QuadSampling::SolidAngle);
+                    let through = light.sample_drawn(p, u, QuadSampling::SolidAngle, Some(drawn));
+                    assert_eq!(sample, through, "{light:?} from {p} with {u}");
+                    assert_eq!(drawn.map(|d| d.wi), sample.map(|s| s.wi));
+                    let wi = drawn.map_or(Vec3::Y, |d| d.wi);
+                    let pdf = light.pdf(p, wi, QuadSampling::SolidAngle);
+                    assert_eq!(
+                        frame.pdf(p, wi).to_bits(),
+                        pdf.to_bits(),
+                        "{light:?} {p} {wi}"
+                    );
+                    framed += usize::from(sample.is_some());
+                }
+            }
+        }
+        assert!(framed > 20, "only {framed} samples had weight");
+        let parallelogram = quad(Vec3::ZERO, Vec3::X, Vec3::new(0.5, 0.0, 1.0));
+        assert!(parallelogram.rectangle_frame().is_none());
+        let sphere = Light::Sphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+            radiance: Vec3::ONE,
+        };
+        assert!(sphere.rectangle_frame().is_none());
     }
 }
