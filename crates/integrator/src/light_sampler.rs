@@ -117,7 +117,21 @@ impl Emitters<'_> {
         }
     }
 
-    /// [`Emitters::sample`], where the chosen sphere light's direction sample was `drawn`
+    /// The light `u_choice` makes [`Emitters::sample`] aim at, where that is a rectangle
+    /// sampled by solid angle: whose direction samples a wave draws in a loop of their
+    /// own ([`RectangleDraws`]).
+    #[inline]
+    pub fn chosen_rectangle(&self, u_choice: f32) -> Option<usize> {
+        if self.quad_sampling != QuadSampling::SolidAngle {
+            return None;
+        }
+        match self.sampler.choose(u_choice)?.0 {
+            Emitter::Light(i) => self.sampler.rectangles[i].is_some().then_some(i),
+            Emitter::Sky => None,
+        }
+    }
+
+    /// [`Emitters::sample`], where the chosen light's direction sample was `drawn`
     /// already ([`Light::sample_drawn`]).
     #[inline]
     pub fn sample_drawn(
@@ -208,6 +222,47 @@ impl Emitters<'_> {
             QuadSampling::SolidAngle => self.sampler.rectangles[i].as_ref(),
             QuadSampling::Area => None,
         }
+    }
+}
+
+/// The rectangle lights' direction samples that a wave's next-event estimation asks for,
+/// drawn one after another in a loop of their own, each through its light's frame. One
+/// sample is a chain of about 300 cycles of f64 square roots, divisions and trigonometry
+/// that the next statement of the shading waits on; a loop of nothing else lets the
+/// processor run the next sample's chain while the last one's finishes.
+#[derive(Debug, Default)]
+pub(crate) struct RectangleDraws {
+    /// Per request: the shading point, `u` and the light.
+    requests: Vec<(Vec3, Vec2, usize)>,
+    /// Per request, after [`RectangleDraws::draw`]: its sample.
+    pub drawn: Vec<Option<DirectionSample>>,
+}
+
+impl RectangleDraws {
+    pub fn clear(&mut self) {
+        self.requests.clear();
+        self.drawn.clear();
+    }
+
+    /// Asks for a sample of rectangle light `light` from `p` with `u`; its index in
+    /// `drawn`.
+    #[inline(always)]
+    pub fn request(&mut self, p: Vec3, light: usize, u: Vec2) -> usize {
+        self.requests.push((p, u, light));
+        self.requests.len() - 1
+    }
+
+    /// Draws every request's sample: what [`Emitters::sample`] would draw for it.
+    pub fn draw(&mut self, emitters: &Emitters<'_>) {
+        self.drawn.clear();
+        let frames = &emitters.sampler.rectangles;
+        self.drawn
+            .extend(self.requests.iter().map(|&(p, u, light)| {
+                frames[light]
+                    .as_ref()
+                    .expect("requests name rectangles")
+                    .sample(p, u)
+            }));
     }
 }
 

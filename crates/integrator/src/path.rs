@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 use lueur_materials::Material;
-use lueur_sampling::Sampler;
+use lueur_sampling::{DirectionSample, Sampler};
 use lueur_sdf_math::Ray;
 
 use lueur_sdf_math::TraceParams;
@@ -16,7 +16,7 @@ use crate::surface::{March, SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::{PathRay, ShadowRay, TraceScratch, Tracing};
 use lueur_scene::RenderSettings;
 
-use crate::light_sampler::SphereDraws;
+use crate::light_sampler::{RectangleDraws, SphereDraws};
 use crate::{Hit, PreparedScene, TraceCounters};
 
 /// Counters per kind of ray.
@@ -131,16 +131,47 @@ impl Shaded {
     };
 }
 
-/// A vertex waiting to be shaded: its path, where it is, its numbers, its sphere-light
-/// sample's index in the wave's [`SphereDraws`] where next-event estimation chose one,
-/// and its direction's in the wave's [`CosineDraws`] where it scatters by the cosine.
+/// A vertex waiting to be shaded: its path, where it is, its numbers, where the wave drew
+/// its next-event estimation's light sample, and its direction's index in the wave's
+/// [`CosineDraws`] where it scatters by the cosine.
 struct Pending {
     path: usize,
     on_surface: SurfaceHit,
     surface: SurfacePoint,
     u: VertexSample,
-    sphere: Option<usize>,
+    light: Option<LightDraw>,
     cosine: Option<usize>,
+}
+
+/// Where a wave drew a vertex's light sample: its index in the wave's [`SphereDraws`] or
+/// [`RectangleDraws`].
+#[derive(Clone, Copy)]
+enum LightDraw {
+    Sphere(usize),
+    Rectangle(usize),
+}
+
+/// The light samples a wave draws together.
+#[derive(Default)]
+struct LightDraws {
+    spheres: SphereDraws,
+    rectangles: RectangleDraws,
+}
+
+impl LightDraws {
+    fn clear(&mut self) {
+        self.spheres.clear();
+        self.rectangles.clear();
+    }
+
+    /// The sample `light` names, drawn.
+    #[inline(always)]
+    fn drawn(&self, light: LightDraw) -> Option<DirectionSample> {
+        match light {
+            LightDraw::Sphere(k) => self.spheres.drawn[k],
+            LightDraw::Rectangle(k) => self.rectangles.drawn[k],
+        }
+    }
 }
 
 /// A thread's buffers for [`radiance_wave`], kept from one wave to the next.
@@ -155,7 +186,7 @@ pub(crate) struct WaveScratch {
     surfaces: Vec<SurfacePoint>,
     surface_scratch: SurfaceScratch,
     pending: Vec<Pending>,
-    spheres: SphereDraws,
+    lights: LightDraws,
     cosines: CosineDraws,
     shaded: Vec<Shaded>,
     shadow: ShadowQueue,
@@ -179,13 +210,13 @@ fn material_at(scene: &PreparedScene, on_surface: SurfaceHit) -> Material {
 
 /// Shades the path of `pending` (`path`) where it met its surface: the shadow rays the
 /// vertex proposes (queued in `shadow`; at a diffuse vertex the delta lights', then
-/// next-event estimation's where the strategy uses it, its sphere-light sample taken from
-/// `spheres` where the wave drew it) and the direction it scatters in.
+/// next-event estimation's where the strategy uses it, its light sample taken from
+/// `lights` where the wave drew it) and the direction it scatters in.
 fn shade(
     estimator: &Estimator<'_>,
     lighting: &Lighting<'_>,
     (pending, path): (&Pending, &Path),
-    (spheres, cosines): (&SphereDraws, &CosineDraws),
+    (lights, cosines): (&LightDraws, &CosineDraws),
     shadow: &mut ShadowQueue,
     out: &mut Shaded,
 ) {
@@ -197,7 +228,7 @@ fn shade(
         on_surface,
         surface,
         ref u,
-        sphere,
+        light,
         cosine,
     } = pending;
     let material = material_at(scene, on_surface);
@@ -231,7 +262,7 @@ fn shade(
             // the ray is stored in pieces and loaded whole, and the load waits for the
             // stores.
             out.next_event = strategy::uses_next_event(settings.strategy)
-                && match lighting.next_event(&vertex, u, sphere.map(|k| spheres.drawn[k])) {
+                && match lighting.next_event(&vertex, u, light.map(|l| lights.drawn(l))) {
                     Some((ray, contribution)) => {
                         shadow.rays.push(ray);
                         shadow.contributions.push(contribution);
@@ -323,7 +354,7 @@ pub(crate) fn radiance_wave(
         );
 
         s.pending.clear();
-        s.spheres.clear();
+        s.lights.clear();
         s.cosines.clear();
         let mut surfaces = s.surfaces.iter();
         for (&i, &hit) in s.active.iter().zip(&s.hits) {
@@ -340,14 +371,23 @@ pub(crate) fn radiance_wave(
                 .next()
                 .expect("a shading point for each hit that scatters");
             let u = VertexSample::draw(&mut samplers[i], ids[i].pixel, ids[i].index, path.depth);
-            // Next-event estimation toward a sphere light, and the cosine-weighted
-            // direction a diffuse vertex scatters in: drawn below, with the wave's others.
+            // Next-event estimation toward a sphere or rectangle light, and the
+            // cosine-weighted direction a diffuse vertex scatters in: drawn below, with the
+            // wave's others.
             let diffuse = matches!(material_at(scene, on_surface), Material::Lambertian { .. });
             let next_event = strategy::uses_next_event(settings.strategy) && diffuse;
-            let sphere = next_event
-                .then(|| lighting.emitters.chosen_sphere(u.emitter_choice))
-                .flatten()
-                .map(|sphere| s.spheres.request(surface.p, sphere, u.emitter));
+            let emitters = &lighting.emitters;
+            let light = if !next_event {
+                None
+            } else if let Some(sphere) = emitters.chosen_sphere(u.emitter_choice) {
+                let k = s.lights.spheres.request(surface.p, sphere, u.emitter);
+                Some(LightDraw::Sphere(k))
+            } else {
+                emitters.chosen_rectangle(u.emitter_choice).map(|light| {
+                    let k = s.lights.rectangles.request(surface.p, light, u.emitter);
+                    LightDraw::Rectangle(k)
+                })
+            };
             let cosine = (diffuse && strategy::scatters_by_cosine(settings.strategy))
                 .then(|| s.cosines.request(u.bsdf));
             s.pending.push(Pending {
@@ -355,11 +395,12 @@ pub(crate) fn radiance_wave(
                 on_surface,
                 surface,
                 u,
-                sphere,
+                light,
                 cosine,
             });
         }
-        s.spheres.draw(tracing.simd);
+        s.lights.spheres.draw(tracing.simd);
+        s.lights.rectangles.draw(&lighting.emitters);
         s.cosines.draw(tracing.simd);
 
         s.shaded.resize(s.pending.len(), Shaded::UNSET);
@@ -371,7 +412,7 @@ pub(crate) fn radiance_wave(
                 estimator,
                 &lighting,
                 (pending, path),
-                (&s.spheres, &s.cosines),
+                (&s.lights, &s.cosines),
                 &mut s.shadow,
                 out,
             );
