@@ -271,8 +271,15 @@ fn shade(
                     None => false,
                 };
             let cosine = cosine.map(|k| cosines.drawn[k]);
-            out.scatter =
-                strategy::scatter(settings.strategy, &lighting.emitters, &vertex, u, cosine);
+            let emitters = &lighting.emitters;
+            strategy::scatter_into(
+                settings.strategy,
+                emitters,
+                &vertex,
+                u,
+                cosine,
+                &mut out.scatter,
+            );
         }
     }
     out.shadow = (first, shadow.rays.len());

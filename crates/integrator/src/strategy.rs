@@ -154,6 +154,38 @@ pub(crate) fn scatter(
     }
 }
 
+/// [`scatter`], written into `out`: MIS, the default, inline, into the slot as it is made;
+/// the other strategies through a call. Through one `match`, the arms' results meet in a
+/// temporary stored in pieces and loaded whole, and the shading waits on the load
+/// (docs/PERFORMANCE.md, "Stores loaded whole").
+#[inline(always)]
+pub(crate) fn scatter_into(
+    strategy: Strategy,
+    emitters: &Emitters<'_>,
+    v: &Vertex,
+    u: &VertexSample,
+    cosine: Option<Vec3>,
+    out: &mut Option<Scatter>,
+) {
+    if strategy == Strategy::Mis {
+        *out = mis_bsdf(v, u.bsdf, cosine);
+    } else {
+        scatter_out_of_line(strategy, emitters, v, u, cosine, out);
+    }
+}
+
+#[inline(never)]
+fn scatter_out_of_line(
+    strategy: Strategy,
+    emitters: &Emitters<'_>,
+    v: &Vertex,
+    u: &VertexSample,
+    cosine: Option<Vec3>,
+    out: &mut Option<Scatter>,
+) {
+    *out = scatter(strategy, emitters, v, u, cosine);
+}
+
 /// Whether `strategy` scatters from a diffuse vertex by cosine sampling, whose
 /// directions a wave draws in lanes ([`CosineDraws`]).
 pub(crate) fn scatters_by_cosine(strategy: Strategy) -> bool {
