@@ -5,8 +5,8 @@
 
 use glam::{Vec2, Vec3};
 use lueur_sampling::{
-    DirectionSample, DiscreteDistribution, Frame, RectangleFrame, cosine_hemisphere_pdf,
-    sample_cosine_hemisphere, sample_sphere_light_lanes,
+    DirectionSample, DiscreteDistribution, Frame, RectangleFrame, SphericalRectangle,
+    cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_sphere_light_lanes,
 };
 use lueur_sdf_math::{Lane, LaneKernel, LaneVec3, MAX_LANES, SimdLevel, write_lane};
 
@@ -234,6 +234,8 @@ impl Emitters<'_> {
 pub(crate) struct RectangleDraws {
     /// Per request: the shading point, `u` and the light.
     requests: Vec<(Vec3, Vec2, usize)>,
+    /// Per request, while it is drawn: the light seen from its point.
+    seen: Vec<Option<SphericalRectangle>>,
     /// Per request, after [`RectangleDraws::draw`]: its sample.
     pub drawn: Vec<Option<DirectionSample>>,
 }
@@ -252,17 +254,26 @@ impl RectangleDraws {
         self.requests.len() - 1
     }
 
-    /// Draws every request's sample: what [`Emitters::sample`] would draw for it.
+    /// Draws every request's sample: what [`Emitters::sample`] would draw for it. The
+    /// rectangles seen from every point first, then every sample: a loop of both would
+    /// be too long for the processor to start one request's chain before the last one's
+    /// ends.
     pub fn draw(&mut self, emitters: &Emitters<'_>) {
-        self.drawn.clear();
         let frames = &emitters.sampler.rectangles;
-        self.drawn
-            .extend(self.requests.iter().map(|&(p, u, light)| {
-                frames[light]
-                    .as_ref()
-                    .expect("requests name rectangles")
-                    .sample(p, u)
-            }));
+        let frame = |light: usize| frames[light].as_ref().expect("requests name rectangles");
+        self.seen.clear();
+        self.seen.extend(
+            self.requests
+                .iter()
+                .map(|&(p, _, light)| frame(light).seen_from(p)),
+        );
+        self.drawn.clear();
+        self.drawn.extend(
+            self.requests
+                .iter()
+                .zip(&self.seen)
+                .map(|(&(p, u, light), seen)| frame(light).sample_seen(seen.as_ref(), p, u)),
+        );
     }
 }
 

@@ -398,7 +398,20 @@ impl RectangleFrame {
     /// rectangle seen from `p` exists, else by area.
     #[inline]
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<DirectionSample> {
-        match self.seen_from(p) {
+        self.sample_seen(self.seen_from(p).as_ref(), p, u)
+    }
+
+    /// [`RectangleFrame::sample`], given the light's `rectangle` seen from `p`
+    /// ([`RectangleFrame::seen_from`]): for a renderer that makes the rectangles of many
+    /// points before it samples any.
+    #[inline]
+    pub fn sample_seen(
+        &self,
+        rectangle: Option<&SphericalRectangle>,
+        p: Vec3,
+        u: Vec2,
+    ) -> Option<DirectionSample> {
+        match rectangle {
             Some(rectangle) => rectangle.sample(u),
             None => sample_quad_area(p, self.corner, self.edge_u, self.edge_v, u),
         }
