@@ -198,6 +198,7 @@ impl SphericalRectangle {
     /// height along the resulting vertical edge uniformly in the projected
     /// coordinate `h`. `None` only if rounding defeats the invariant of
     /// [`DirectionSample`].
+    #[inline]
     pub fn sample(&self, u: Vec2) -> Option<DirectionSample> {
         let u = clamp_u2(u).as_dvec2();
         // au = u.x S + k, by the angle-sum formulas.
