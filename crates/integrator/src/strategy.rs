@@ -440,8 +440,9 @@ impl<'a> Lighting<'a> {
     /// sampling by [`next_event_weight`]: what it brings if its shadow ray is free, with
     /// that ray; `None` where it brings nothing whatever the ray finds.
     ///
-    /// `drawn` is the chosen sphere light's direction sample where the wave drew it
-    /// already ([`crate::light_sampler::SphereDraws`]), `None` otherwise.
+    /// `drawn` is the chosen light's direction sample where the wave drew it already
+    /// ([`crate::light_sampler::SphereDraws`], [`crate::light_sampler::RectangleDraws`]),
+    /// `None` otherwise.
     #[inline]
     pub fn next_event(
         &self,
