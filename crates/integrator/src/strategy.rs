@@ -478,6 +478,7 @@ mod tests {
     //! normal (`lueur_stats::DirectionBins`), after checking that the pdf
     //! each sample reports is the strategy's pdf at its direction.
     use super::*;
+    use crate::light_sampler::RectangleDraws;
     use lueur_scene::{Camera, Light, QuadSampling, Scene};
     use lueur_stats::DirectionBins;
 
@@ -616,6 +617,49 @@ mod tests {
                     assert_eq!(draws.drawn[k], alone, "{level:?}, {n} requests, u = {u}");
                 }
             }
+        }
+    }
+
+    /// A wave's rectangle-light samples, drawn together through the lights' frames, are
+    /// the bits the light gives for each alone, for points in front of the light, behind
+    /// it (no sample) and far away; and they are asked for only where the light is a
+    /// rectangle sampled by solid angle.
+    #[test]
+    fn rectangle_draws_are_each_sample_alone() {
+        let scene = scene(false);
+        for quads in [QuadSampling::SolidAngle, QuadSampling::Area] {
+            let emitters = scene.emitters(quads);
+            let mut u = uniforms(11);
+            let mut draws = RectangleDraws::default();
+            let mut asked = Vec::new();
+            for i in 0..96 {
+                let far = if i % 8 == 0 { 1e3 } else { 1.0 };
+                let p = Vec3::new(4.0 * u() - 1.0, 4.0 * u() - 1.0, 4.0 * u() - 2.0) * far;
+                let (choice, e) = (u(), Vec2::new(u(), u()));
+                if let Some(light) = emitters.chosen_rectangle(choice) {
+                    asked.push((draws.request(p, light, e), light, p, choice, e));
+                }
+            }
+            draws.draw(&emitters);
+            if quads == QuadSampling::Area {
+                assert!(
+                    asked.is_empty(),
+                    "area-sampled quads are drawn where they are used"
+                );
+                continue;
+            }
+            assert!(asked.len() > 30, "only {} requests", asked.len());
+            let mut sampled = 0;
+            for (k, light, p, choice, e) in asked {
+                let alone = scene.scene().lights[light].sample(p, e, quads);
+                assert_eq!(draws.drawn[k].map(|d| d.wi), alone.map(|s| s.wi), "{p} {e}");
+                let n = Vec3::Y;
+                let through = emitters.sample_drawn(p, n, choice, e, Some(draws.drawn[k]));
+                assert_eq!(through, emitters.sample(p, n, choice, e));
+                assert_eq!(through.map(|(s, _)| s.wi), alone.map(|s| s.wi));
+                sampled += usize::from(alone.is_some());
+            }
+            assert!(sampled > 10, "only {sampled} samples had weight");
         }
     }
 
