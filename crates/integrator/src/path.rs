@@ -7,7 +7,7 @@
 use glam::Vec3;
 use lueur_materials::Material;
 use lueur_sampling::{DirectionSample, Sampler};
-use lueur_sdf_math::Ray;
+use lueur_sdf_math::{Ray, SimdLevel};
 
 use lueur_sdf_math::TraceParams;
 
@@ -16,7 +16,7 @@ use crate::surface::{March, SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::{PathRay, ShadowRay, TraceScratch, Tracing};
 use lueur_scene::RenderSettings;
 
-use crate::light_sampler::{RectangleDraws, SphereDraws};
+use crate::light_sampler::{Emitters, RectangleDraws, SphereDraws};
 use crate::{Hit, PreparedScene, TraceCounters};
 
 /// Counters per kind of ray.
@@ -162,6 +162,12 @@ impl LightDraws {
     fn clear(&mut self) {
         self.spheres.clear();
         self.rectangles.clear();
+    }
+
+    /// Draws every request's sample, spheres on `level`.
+    fn draw(&mut self, level: SimdLevel, emitters: &Emitters<'_>) {
+        self.spheres.draw(level);
+        self.rectangles.draw(emitters);
     }
 
     /// The sample `light` names, drawn.
@@ -406,8 +412,7 @@ pub(crate) fn radiance_wave(
                 cosine,
             });
         }
-        s.lights.spheres.draw(tracing.simd);
-        s.lights.rectangles.draw(&lighting.emitters);
+        s.lights.draw(tracing.simd, &lighting.emitters);
         s.cosines.draw(tracing.simd);
 
         s.shaded.resize(s.pending.len(), Shaded::UNSET);

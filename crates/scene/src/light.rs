@@ -252,8 +252,9 @@ impl Light {
                 let s = match (drawn, quad_sampling) {
                     (Some(s), _) => s?,
                     (None, QuadSampling::SolidAngle) if is_rectangle(edge_u, edge_v) => {
-                        // Falls back to area sampling where the solid angle is
-                        // too small for the spherical-rectangle warp's f32 math.
+                        // Falls back to area sampling where the spherical
+                        // rectangle cannot be sampled accurately (its solid angle
+                        // too small, or too near 2pi).
                         sample_quad_solid_angle(p, corner, edge_u, edge_v, u)?
                     }
                     (None, _) => sample_quad_area(p, corner, edge_u, edge_v, u)?,
