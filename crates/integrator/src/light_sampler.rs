@@ -122,11 +122,8 @@ impl Emitters<'_> {
     /// own ([`RectangleDraws`]).
     #[inline]
     pub fn chosen_rectangle(&self, u_choice: f32) -> Option<usize> {
-        if self.quad_sampling != QuadSampling::SolidAngle {
-            return None;
-        }
         match self.sampler.choose(u_choice)?.0 {
-            Emitter::Light(i) => self.sampler.rectangles[i].is_some().then_some(i),
+            Emitter::Light(i) => self.rectangle(i).map(|_| i),
             Emitter::Sky => None,
         }
     }
@@ -243,6 +240,7 @@ pub(crate) struct RectangleDraws {
 impl RectangleDraws {
     pub fn clear(&mut self) {
         self.requests.clear();
+        self.seen.clear();
         self.drawn.clear();
     }
 
@@ -259,8 +257,7 @@ impl RectangleDraws {
     /// be too long for the processor to start one request's chain before the last one's
     /// ends.
     pub fn draw(&mut self, emitters: &Emitters<'_>) {
-        let frames = &emitters.sampler.rectangles;
-        let frame = |light: usize| frames[light].as_ref().expect("requests name rectangles");
+        let frame = |light| emitters.rectangle(light).expect("requests name rectangles");
         self.seen.clear();
         self.seen.extend(
             self.requests
