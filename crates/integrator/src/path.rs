@@ -383,7 +383,13 @@ pub(crate) fn radiance_wave(
             let surface = *surfaces
                 .next()
                 .expect("a shading point for each hit that scatters");
-            let u = VertexSample::draw(&mut samplers[i], ids[i].pixel, ids[i].index, path.depth);
+            let u = VertexSample::draw(
+                &mut samplers[i],
+                ids[i].pixel,
+                ids[i].index,
+                path.depth,
+                settings.strategy,
+            );
             // Next-event estimation toward a sphere or rectangle light, and the
             // cosine-weighted direction a diffuse vertex scatters in: drawn below, with the
             // wave's others.

@@ -43,13 +43,31 @@ pub(crate) struct VertexSample {
 }
 
 impl VertexSample {
-    /// The numbers of vertex `depth` of sample `index` of `pixel`.
+    /// The numbers of vertex `depth` of sample `index` of `pixel` that `strategy` uses;
+    /// the others are skipped (left 0), which changes no number drawn: each has its
+    /// dimension whatever is drawn before it.
     #[inline]
-    pub fn draw(sampler: &mut Sampler, pixel: [u32; 2], index: u32, depth: u32) -> VertexSample {
+    pub fn draw(
+        sampler: &mut Sampler,
+        pixel: [u32; 2],
+        index: u32,
+        depth: u32,
+        strategy: Strategy,
+    ) -> VertexSample {
         sampler.start_pixel_sample(pixel, index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
-        let emitter_choice = sampler.next_1d();
-        let emitter = sampler.next_2d();
-        let mixture = sampler.next_1d();
+        let lights = !matches!(strategy, Strategy::Uniform | Strategy::Cosine);
+        let (emitter_choice, emitter) = if lights {
+            (sampler.next_1d(), sampler.next_2d())
+        } else {
+            sampler.skip(3);
+            (0.0, Vec2::ZERO)
+        };
+        let mixture = if strategy == Strategy::Mixture {
+            sampler.next_1d()
+        } else {
+            sampler.skip(1);
+            0.0
+        };
         let bsdf = sampler.next_2d();
         let roulette = sampler.next_1d();
         VertexSample {

@@ -10,7 +10,7 @@ pub(crate) const GOLDEN_GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
 /// splittable pseudorandom number generators", OOPSLA; constants from
 /// Stafford's "Mix13"): a bijective 64-bit mixer with good avalanche.
 #[inline]
-pub(crate) fn mix64(mut z: u64) -> u64 {
+pub(crate) const fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
@@ -21,7 +21,21 @@ pub(crate) fn mix64(mut z: u64) -> u64 {
 /// streams.
 #[inline]
 pub fn hash2(a: u64, b: u64) -> u64 {
-    mix64(a ^ mix64(b.wrapping_add(GOLDEN_GAMMA)))
+    hash2_keyed(a, hash_key(b))
+}
+
+/// What [`hash2`] makes of its second word alone: `hash2(a, b)` is
+/// `hash2_keyed(a, hash_key(b))`, so that a caller hashing many `a`s with
+/// few `b`s (a sampler's dimensions) can make the keys once.
+#[inline]
+pub const fn hash_key(b: u64) -> u64 {
+    mix64(b.wrapping_add(GOLDEN_GAMMA))
+}
+
+/// [`hash2`] of `a` and the word `key` was made from by [`hash_key`].
+#[inline]
+pub fn hash2_keyed(a: u64, key: u64) -> u64 {
+    mix64(a ^ key)
 }
 
 /// Hash of three words.

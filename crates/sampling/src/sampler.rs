@@ -6,7 +6,7 @@ use rand_pcg::Pcg32;
 use rand_pcg::rand_core::Rng;
 
 use lueur_pointsets::construct::{
-    PMJ02_TABLE_LEN, PMJ02_TABLES, cmj, hash2, permute, pmj02_table_point,
+    PMJ02_TABLE_LEN, PMJ02_TABLES, cmj, hash_key, hash2, hash2_keyed, permute, pmj02_table_point,
 };
 use lueur_pointsets::{
     HALTON_MAX_DIMENSIONS, SOBOL_MAX_DIMENSIONS, halton_base, laine_karras_permutation,
@@ -64,6 +64,10 @@ pub struct Sampler {
     /// request's scramble seed ([`Sampler::sequence_hash`]) that a pixel sample shares,
     /// hashed once when it starts.
     pixel_hash: u64,
+    /// The sample index `pixel_hash` and `replicate_seed` were made for (with `pixel`),
+    /// `None` before any: a path's vertices start the same pixel sample again at each
+    /// depth, and find them made.
+    hashed_sample: Option<u32>,
     /// `index.reverse_bits()`, where the padded Sobol' kinds scramble it.
     reversed_index: u32,
     rng: Pcg32,
@@ -150,6 +154,19 @@ const PERMUTATIONS_4: [[u8; 4]; 24] = [
     [3, 0, 1, 2],
 ];
 
+/// `hash_key(d)` of the first dimensions (a path of depth 31 at most), which every
+/// request of a hashed kind hashes its pixel sample's seed with: made at compile time,
+/// a load instead of a chain of two multiplications per request.
+const DIMENSION_KEYS: [u64; 256] = {
+    let mut keys = [0; 256];
+    let mut d = 0;
+    while d < keys.len() {
+        keys[d] = hash_key(d as u64);
+        d += 1;
+    }
+    keys
+};
+
 /// Mixed into the seed of replicates past the first, so that their
 /// randomizations are not those of another seed's replicate 0.
 const REPLICATE_KEY: u64 = 0x7265_706c_6963_6174;
@@ -217,6 +234,7 @@ impl Sampler {
             index: 0,
             dimension: 0,
             pixel_hash: 0,
+            hashed_sample: None,
             reversed_index: 0,
             rng: Pcg32::new(0, 0),
             stream_position: u64::MAX,
@@ -246,21 +264,26 @@ impl Sampler {
         let same_pixel = self.pixel == pixel;
         self.pixel = pixel;
         self.dimension = dimension;
-        if self.replicates > 1 && self.kind != SamplerKind::Independent {
-            let replicate = sample_index % self.replicates;
-            self.index = sample_index / self.replicates;
-            self.replicate_seed = if replicate == 0 {
-                self.seed
-            } else {
-                hash2(self.seed ^ REPLICATE_KEY, u64::from(replicate))
-            };
-        } else {
-            self.index = sample_index;
-        }
         if self.kind != SamplerKind::Independent {
+            if same_pixel && self.hashed_sample == Some(sample_index) {
+                return;
+            }
+            self.hashed_sample = Some(sample_index);
+            if self.replicates > 1 {
+                let replicate = sample_index % self.replicates;
+                self.index = sample_index / self.replicates;
+                self.replicate_seed = if replicate == 0 {
+                    self.seed
+                } else {
+                    hash2(self.seed ^ REPLICATE_KEY, u64::from(replicate))
+                };
+            } else {
+                self.index = sample_index;
+            }
             self.pixel_hash = hash2(self.replicate_seed, pixel_key(pixel));
             self.reversed_index = self.index.reverse_bits();
         } else {
+            self.index = sample_index;
             let position =
                 u64::from(sample_index) * u64::from(DIMENSIONS_PER_SAMPLE) + u64::from(dimension);
             // The stream is the pixel's; a position ahead on it is reached from where the
@@ -307,6 +330,21 @@ impl Sampler {
         value
     }
 
+    /// Moves `n` dimensions on without drawing them, leaving the sampler where `n` calls of
+    /// [`Sampler::next_1d`] would (or `n / 2` of [`Sampler::next_2d`]): for the numbers of
+    /// a fixed layout that a caller has no use for, whose hashing it then does not pay.
+    #[inline]
+    pub fn skip(&mut self, n: u32) {
+        if self.kind == SamplerKind::Independent {
+            for _ in 0..n {
+                self.rng.next_u32();
+            }
+            self.stream_position = self.stream_position.wrapping_add(u64::from(n));
+        } else {
+            self.dimension = self.dimension.wrapping_add(n);
+        }
+    }
+
     /// The scramble seed of the current (pixel, dimension), and of the
     /// block of `spp` sample indices the current index is in, so that
     /// indices past `spp` start an independent pattern.
@@ -321,7 +359,11 @@ impl Sampler {
     /// dimension)`, its first step done once per pixel sample.
     #[inline]
     fn sequence_hash(&self, dimension: u32) -> u64 {
-        hash2(self.pixel_hash, u64::from(dimension))
+        let key = match DIMENSION_KEYS.get(dimension as usize) {
+            Some(&key) => key,
+            None => hash_key(u64::from(dimension)),
+        };
+        hash2_keyed(self.pixel_hash, key)
     }
 
     /// Dimension `dimension` of the plain or scrambled Halton or Sobol'
@@ -594,8 +636,10 @@ mod tests {
     /// it stands are the jump from the stream's start.
     #[test]
     fn every_position_gives_the_fresh_samplers_values_whatever_came_before() {
-        let moves: [([u32; 2], u32, u32); 9] = [
+        let moves: [([u32; 2], u32, u32); 11] = [
             ([3, 4], 5, 2),
+            ([3, 4], 5, 300),
+            ([3, 4], 5, 254),
             ([3, 4], 5, 10),
             ([3, 4], 5, 18),
             ([3, 4], 6, 2),
@@ -605,10 +649,10 @@ mod tests {
             ([3, 4], 5, 34),
             ([3, 4], 63, 65_535),
         ];
-        for &kind in SamplerKind::ALL {
-            let mut moving = Sampler::for_image(kind, 11, [16, 16], 64);
+        for (&kind, replicates) in SamplerKind::ALL.iter().flat_map(|k| [(k, 1), (k, 3)]) {
+            let mut moving = Sampler::for_render(kind, 11, [16, 16], 64, replicates);
             for &(pixel, index, dimension) in &moves {
-                let mut fresh = Sampler::for_image(kind, 11, [16, 16], 64);
+                let mut fresh = Sampler::for_render(kind, 11, [16, 16], 64, replicates);
                 fresh.start_pixel_sample(pixel, index, dimension);
                 moving.start_pixel_sample(pixel, index, dimension);
                 for _ in 0..3 {
@@ -619,6 +663,30 @@ mod tests {
                     );
                     assert_eq!(moving.next_2d(), fresh.next_2d(), "{kind:?}");
                 }
+            }
+        }
+    }
+
+    /// Skipped numbers leave the sampler where drawing them would: the next request is
+    /// the same, bit for bit, for every kind, 1D and 2D, across the dimension table's end.
+    #[test]
+    fn skipping_dimensions_lands_where_drawing_them_would() {
+        for (&kind, replicates) in SamplerKind::ALL.iter().flat_map(|k| [(k, 1), (k, 2)]) {
+            for (start, n) in [(0, 1), (2, 3), (10, 2), (253, 5), (400, 1)] {
+                let mut drawn = Sampler::for_render(kind, 5, [8, 8], 16, replicates);
+                let mut skipped = drawn.clone();
+                drawn.start_pixel_sample([1, 2], 3, start);
+                skipped.start_pixel_sample([1, 2], 3, start);
+                for _ in 0..n {
+                    drawn.next_1d();
+                }
+                skipped.skip(n);
+                assert_eq!(
+                    drawn.next_1d().to_bits(),
+                    skipped.next_1d().to_bits(),
+                    "{kind:?}"
+                );
+                assert_eq!(drawn.next_2d(), skipped.next_2d(), "{kind:?}");
             }
         }
     }
