@@ -17,7 +17,11 @@
 //!    render time (lueur: its own measured render; Mitsuba: the warm
 //!    render, the kernel compile of the JIT variant reported apart), so
 //!    samples per second and MSE x time (lower is better: the time needed
-//!    for a given error is proportional to it) compare in one run.
+//!    for a given error is proportional to it) compare in one run. Times
+//!    are medians over rounds that interleave the configurations, and
+//!    lueur's ratios to Mitsuba are taken within each round: on a shared
+//!    machine a median of one configuration's renders in a row moved by
+//!    10-25% between runs, and a slow spell fell on whichever ran in it.
 //!    Writes `docs/PEERS.md`.
 
 use std::collections::HashMap;
@@ -41,9 +45,10 @@ const LLVM19: &str = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1";
 struct Plan {
     size: u32,
     spps: &'static [u32],
-    /// The spp whose time is a median of `repeats` renders: the speed table.
-    timed_spp: u32,
-    repeats: u32,
+    /// Rounds of renders, each of every configuration at every spp, interleaved: a time is
+    /// the median over rounds, and a ratio is taken within each round before its median,
+    /// so that a slow spell of a shared machine falls on every configuration alike.
+    rounds: u32,
     reference_passes: u32,
     reference_pass_spp: u32,
     /// lueur's render for the correctness z-map.
@@ -54,8 +59,7 @@ const PLANS: Plans<Plan> = Plans {
     full: Plan {
         size: 256,
         spps: &[4, 16, 64, 256],
-        timed_spp: 64,
-        repeats: 3,
+        rounds: 3,
         reference_passes: 16,
         reference_pass_spp: 256,
         correctness_spp: 1024,
@@ -63,8 +67,7 @@ const PLANS: Plans<Plan> = Plans {
     quick: Plan {
         size: 64,
         spps: &[4, 16],
-        timed_spp: 16,
-        repeats: 1,
+        rounds: 1,
         reference_passes: 4,
         reference_pass_spp: 64,
         correctness_spp: 64,
@@ -89,10 +92,13 @@ impl Config {
     }
 }
 
-/// One render's figures.
+/// One configuration's figures at one spp.
 struct Measured {
     spp: u32,
+    /// The median of `round_seconds`.
     seconds: f64,
+    /// Its render time in each round, in round order.
+    round_seconds: Vec<f64>,
     /// Mitsuba's JIT variants: the first render, kernel compile included.
     first_seconds: Option<f64>,
     mse: f64,
@@ -204,22 +210,46 @@ pub fn run(quick: bool) -> Result<()> {
             sampler: "ldsampler",
         },
     ];
-    let mut results: Vec<(Config, Vec<Measured>)> = Vec::new();
-    for config in configs {
-        let mut rows = Vec::new();
-        for &spp in plan.spps {
-            let m = measure(plan, &file, &work, &against, config, spp)?;
-            eprintln!(
-                "{:<36} {:>4} spp  {:>7.2} s  MSE {:.3e}",
-                config.name(),
-                spp,
-                m.seconds,
-                m.mse
-            );
-            rows.push(m);
+    // Every configuration at one spp, then the next spp; the configurations' order reversed
+    // every other round, so that none always runs right after the same one.
+    let mut rows: Vec<Vec<Option<Measured>>> = (configs.iter())
+        .map(|_| plan.spps.iter().map(|_| None).collect())
+        .collect();
+    for round in 0..plan.rounds {
+        for (s, &spp) in plan.spps.iter().enumerate() {
+            let mut order: Vec<usize> = (0..configs.len()).collect();
+            if round % 2 == 1 {
+                order.reverse();
+            }
+            for k in order {
+                let (seconds, m) = measure(plan, &file, &work, &against, configs[k], spp)?;
+                eprintln!(
+                    "round {}/{}: {:<36} {:>4} spp  {:>7.2} s  MSE {:.3e}",
+                    round + 1,
+                    plan.rounds,
+                    configs[k].name(),
+                    spp,
+                    seconds,
+                    m.mse
+                );
+                let slot = rows[k][s].get_or_insert(m);
+                slot.round_seconds.push(seconds);
+                slot.seconds = median(slot.round_seconds.clone());
+            }
         }
-        results.push((config, rows));
     }
+    let results: Vec<(Config, Vec<Measured>)> = configs
+        .into_iter()
+        .zip(rows)
+        .map(|(c, r)| {
+            (
+                c,
+                r.into_iter()
+                    .map(|m| m.expect("every round measures every spp"))
+                    .collect(),
+            )
+        })
+        .collect();
     let md = report(plan, &results, &correctness, reference_time)?;
     write_report(quick, "PEERS.md", &md)?;
     Ok(())
@@ -302,8 +332,8 @@ fn correctness(
     )
 }
 
-/// One configuration at `spp`: its time (the median of `repeats` renders at
-/// the timed spp) and its MSE against the reference.
+/// One render of a configuration at `spp`: its time, and its figures with their first
+/// round (the MSE against the reference; the images are the same in every round).
 fn measure(
     plan: &Plan,
     file: &SceneFile,
@@ -311,12 +341,7 @@ fn measure(
     reference: &Reference,
     config: Config,
     spp: u32,
-) -> Result<Measured> {
-    let repeats = if spp == plan.timed_spp {
-        plan.repeats
-    } else {
-        1
-    };
+) -> Result<(f64, Measured)> {
     Ok(match config {
         Config::Lueur(sampler) => {
             let settings = RenderSettings {
@@ -327,21 +352,16 @@ fn measure(
                 sampler,
                 ..file.settings.clone()
             };
-            let mut times = Vec::new();
-            let mut film = None;
-            for _ in 0..repeats {
-                let (f, t) = render_film(file, &settings)?;
-                times.push(t);
-                film = Some(f);
-            }
-            let film = film.expect("one render");
+            let (film, seconds) = render_film(file, &settings)?;
             let img = flatten(&film.mean_image());
-            Measured {
+            let m = Measured {
                 spp,
-                seconds: median(times),
+                seconds,
+                round_seconds: Vec::new(),
                 first_seconds: None,
                 mse: reference.mse(&img),
-            }
+            };
+            (seconds, m)
         }
         Config::Mitsuba { variant, sampler } => {
             let out = work.join(format!("{variant}-{sampler}-{spp}.exr"));
@@ -352,7 +372,7 @@ fn measure(
                 "--sampler".into(),
                 sampler.into(),
                 "--repeats".into(),
-                repeats.to_string(),
+                "1".into(),
                 "--width".into(),
                 plan.size.to_string(),
                 "--height".into(),
@@ -361,14 +381,17 @@ fn measure(
             args.extend(["--seed".into(), "0".into()]);
             let numbers = mitsuba(&args)?;
             let img = read_rgb(&out)?;
-            Measured {
+            let seconds = *numbers
+                .get("warm_s")
+                .context("no warm_s from mitsuba_render.py")?;
+            let m = Measured {
                 spp,
-                seconds: *numbers
-                    .get("warm_s")
-                    .context("no warm_s from mitsuba_render.py")?,
+                seconds,
+                round_seconds: Vec::new(),
                 first_seconds: numbers.get("first_s").copied(),
                 mse: reference.mse(&img.pixels),
-            }
+            };
+            (seconds, m)
         }
     })
 }
@@ -498,11 +521,13 @@ fn report(
     writeln!(
         md,
         "Render time (lueur: its own measured render; Mitsuba: the render after a first one, \
-         so a JIT variant's kernel compile, shown apart, is not counted), median of {} at {} spp. \
+         so a JIT variant's kernel compile, shown apart with the first round's, is not counted), \
+         median of {} rounds in which every configuration renders at every spp, interleaved \
+         (their order reversed every other round). \
          MSE against the reference, less the reference's own variance. **MSE x time** is what \
          a given error costs: the time to reach an error is proportional to it (lower is \
          better).\n",
-        plan.repeats, plan.timed_spp
+        plan.rounds
     )?;
     writeln!(
         md,
@@ -551,27 +576,40 @@ fn summary(md: &mut String, plan: &Plan, results: &[(Config, Vec<Measured>)]) ->
             last(&a.1).total_cmp(&last(&b.1))
         });
     if let (Some((lc, lr)), Some((mc, mr))) = (lueur, best_mitsuba) {
-        let at =
-            |r: &[Measured], spp: u32| r.iter().find(|m| m.spp == spp).map(|m| (m.seconds, m.mse));
         writeln!(
             md,
-            "\n**Summary**, {} against {} (the Mitsuba configuration with the lowest MSE x time at {} spp):\n",
+            "\n**Summary**, {} against {} (the Mitsuba configuration with the lowest MSE x time at {} spp); \
+             time ratios taken within each round, then their median (min-max over rounds):\n",
             lc.name(),
             mc.name(),
             plan.spps.last().unwrap()
         )?;
         for &spp in plan.spps {
-            if let (Some((lt, le)), Some((mt, me))) = (at(lr, spp), at(mr, spp)) {
+            if let (Some(l), Some(m)) = (at(lr, spp), at(mr, spp)) {
+                let ratios: Vec<f64> = (l.round_seconds.iter().zip(&m.round_seconds))
+                    .map(|(lt, mt)| lt / mt)
+                    .collect();
+                let (lo, hi) = (ratios.iter())
+                    .fold((f64::INFINITY, 0f64), |(lo, hi), &r| (lo.min(r), hi.max(r)));
+                let time = median(ratios);
+                let mse = l.mse / m.mse;
                 writeln!(
                     md,
-                    "- {spp} spp: lueur takes {:.2}x Mitsuba's time per sample; its MSE x time is {:.2}x Mitsuba's.",
-                    lt / mt,
-                    (le * lt) / (me * mt)
+                    "- {spp} spp: lueur takes {time:.2}x Mitsuba's time per sample ({lo:.2}-{hi:.2}); \
+                     its MSE x time is {:.2}x Mitsuba's ({:.2}-{:.2}).",
+                    mse * time,
+                    mse * lo,
+                    mse * hi
                 )?;
             }
         }
     }
     Ok(())
+}
+
+/// A configuration's figures at `spp`.
+fn at(rows: &[Measured], spp: u32) -> Option<&Measured> {
+    rows.iter().find(|m| m.spp == spp)
 }
 
 /// Whether `python()` can import Mitsuba 3, and numpy, which `mitsuba_render.py`'s
