@@ -154,7 +154,7 @@ const PERMUTATIONS_4: [[u8; 4]; 24] = [
     [3, 0, 1, 2],
 ];
 
-/// `hash_key(d)` of the first dimensions (a path of depth 31 at most), which every
+/// `hash_key(d)` of the first dimensions (every vertex of a path to depth 30), which every
 /// request of a hashed kind hashes its pixel sample's seed with: made at compile time,
 /// a load instead of a chain of two multiplications per request.
 const DIMENSION_KEYS: [u64; 256] = {
