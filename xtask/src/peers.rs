@@ -95,7 +95,7 @@ impl Config {
 /// One configuration's figures at one spp.
 struct Measured {
     spp: u32,
-    /// The median of `round_seconds`.
+    /// One render's time, then, once every round has run, the median of `round_seconds`.
     seconds: f64,
     /// Its render time in each round, in round order.
     round_seconds: Vec<f64>,
@@ -222,19 +222,18 @@ pub fn run(quick: bool) -> Result<()> {
                 order.reverse();
             }
             for k in order {
-                let (seconds, m) = measure(plan, &file, &work, &against, configs[k], spp)?;
+                let m = measure(plan, &file, &work, &against, configs[k], spp)?;
                 eprintln!(
                     "round {}/{}: {:<36} {:>4} spp  {:>7.2} s  MSE {:.3e}",
                     round + 1,
                     plan.rounds,
                     configs[k].name(),
                     spp,
-                    seconds,
+                    m.seconds,
                     m.mse
                 );
-                let slot = rows[k][s].get_or_insert(m);
-                slot.round_seconds.push(seconds);
-                slot.seconds = median(slot.round_seconds.clone());
+                let seconds = m.seconds;
+                rows[k][s].get_or_insert(m).round_seconds.push(seconds);
             }
         }
     }
@@ -245,7 +244,11 @@ pub fn run(quick: bool) -> Result<()> {
             (
                 c,
                 r.into_iter()
-                    .map(|m| m.expect("every round measures every spp"))
+                    .map(|m| {
+                        let mut m = m.expect("every round measures every spp");
+                        m.seconds = median(m.round_seconds.clone());
+                        m
+                    })
                     .collect(),
             )
         })
@@ -332,8 +335,8 @@ fn correctness(
     )
 }
 
-/// One render of a configuration at `spp`: its time, and its figures with their first
-/// round (the MSE against the reference; the images are the same in every round).
+/// One render of a configuration at `spp`: its time and its MSE against the reference
+/// (the images are the same in every round, so the first round's figures are kept).
 fn measure(
     plan: &Plan,
     file: &SceneFile,
@@ -341,7 +344,7 @@ fn measure(
     reference: &Reference,
     config: Config,
     spp: u32,
-) -> Result<(f64, Measured)> {
+) -> Result<Measured> {
     Ok(match config {
         Config::Lueur(sampler) => {
             let settings = RenderSettings {
@@ -354,14 +357,13 @@ fn measure(
             };
             let (film, seconds) = render_film(file, &settings)?;
             let img = flatten(&film.mean_image());
-            let m = Measured {
+            Measured {
                 spp,
                 seconds,
                 round_seconds: Vec::new(),
                 first_seconds: None,
                 mse: reference.mse(&img),
-            };
-            (seconds, m)
+            }
         }
         Config::Mitsuba { variant, sampler } => {
             let out = work.join(format!("{variant}-{sampler}-{spp}.exr"));
@@ -381,17 +383,15 @@ fn measure(
             args.extend(["--seed".into(), "0".into()]);
             let numbers = mitsuba(&args)?;
             let img = read_rgb(&out)?;
-            let seconds = *numbers
-                .get("warm_s")
-                .context("no warm_s from mitsuba_render.py")?;
-            let m = Measured {
+            Measured {
                 spp,
-                seconds,
+                seconds: *numbers
+                    .get("warm_s")
+                    .context("no warm_s from mitsuba_render.py")?,
                 round_seconds: Vec::new(),
                 first_seconds: numbers.get("first_s").copied(),
                 mse: reference.mse(&img.pixels),
-            };
-            (seconds, m)
+            }
         }
     })
 }
