@@ -55,8 +55,7 @@ impl VertexSample {
         strategy: Strategy,
     ) -> VertexSample {
         sampler.start_pixel_sample(pixel, index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
-        let lights = !matches!(strategy, Strategy::Uniform | Strategy::Cosine);
-        let (emitter_choice, emitter) = if lights {
+        let (emitter_choice, emitter) = if samples_emitters(strategy) {
             (sampler.next_1d(), sampler.next_2d())
         } else {
             sampler.skip(3);
@@ -202,6 +201,15 @@ fn scatter_out_of_line(
     out: &mut Option<Scatter>,
 ) {
     *out = scatter(strategy, emitters, v, u, cosine);
+}
+
+/// Whether `strategy` ever samples a point on an emitter (and so reads a vertex's
+/// emitter numbers): next-event estimation, or a scatter toward the lights.
+fn samples_emitters(strategy: Strategy) -> bool {
+    match strategy {
+        Strategy::Light | Strategy::Mixture | Strategy::Mis => true,
+        Strategy::Uniform | Strategy::Cosine => false,
+    }
 }
 
 /// Whether `strategy` scatters from a diffuse vertex by cosine sampling, whose
