@@ -319,15 +319,26 @@ pub(crate) fn radiance_wave(
     } = *estimator;
     let lighting = Lighting::of(scene, settings, &march);
     let s = scratch;
-    s.paths.clear();
-    s.paths.extend(camera_rays.iter().map(|&ray| Path {
-        ray,
+    // Every path starts as the camera's, then takes its ray field by field: a `Path` made
+    // whole per ray is written in pieces on the stack and loaded back whole
+    // (docs/PERFORMANCE.md, "Stores loaded whole").
+    let start = Path {
+        ray: Ray {
+            origin: Vec3::ZERO,
+            dir: Vec3::Z,
+        },
         params: march.camera,
         beta: Vec3::ONE,
         radiance: Vec3::ZERO,
-        previous: Previous::camera(ray.origin),
+        previous: Previous::camera(Vec3::ZERO),
         depth: 0,
-    }));
+    };
+    s.paths.clear();
+    s.paths.resize(camera_rays.len(), start);
+    for (path, ray) in s.paths.iter_mut().zip(camera_rays) {
+        path.ray = *ray;
+        path.previous.p = ray.origin;
+    }
     s.active.clear();
     s.active.extend(0..s.paths.len());
     while !s.active.is_empty() {

@@ -1,12 +1,13 @@
 //! The render loop: tiles in parallel, samples in order within a pixel.
 
 use std::ops::Range;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use glam::UVec2;
+use glam::{UVec2, Vec3};
 use lueur_sampling::Sampler;
-use lueur_sdf_math::SimdLevel;
+use lueur_sdf_math::{Ray, SimdLevel};
 use rayon::prelude::*;
 
 use crate::film::{Film, PixelStats};
@@ -233,6 +234,7 @@ pub fn render_pass_in(
             )
         })?;
     let sink = film.pass_sink(&plan, TILE);
+    let scratch = ScratchPool::default();
     // One tile per job: rayon's adaptive split would otherwise hand each thread runs of
     // up to a quarter of the tiles as one job it cannot share, and a pass would end with a
     // thread idle for several tiles (docs/PERFORMANCE.md, "The progressive passes").
@@ -240,7 +242,15 @@ pub fn render_pass_in(
         .par_iter()
         .with_max_len(1)
         .map(|&origin| {
-            let r = render_tile(&estimator, bounds, origin, plan.pass_blocks(), cancel)?;
+            let r = scratch.lend(|scratch| {
+                render_tile(
+                    &estimator,
+                    (bounds, origin),
+                    plan.pass_blocks(),
+                    cancel,
+                    scratch,
+                )
+            })?;
             // Checked again so that no tile commits after the signal has
             // been seen: what an interrupt writes is what was there then.
             if cancel.load(Ordering::Relaxed) {
@@ -334,13 +344,45 @@ impl TileSink {
     }
 }
 
+/// A thread's buffers for rendering a tile: the wave's samples and everything its paths
+/// are traced and shaded with. Cleared before use, so what they held never reaches an
+/// image.
+#[derive(Default)]
+struct TileScratch {
+    ids: Vec<SampleId>,
+    rays: Vec<Ray>,
+    samplers: Vec<Sampler>,
+    estimates: Vec<Vec3>,
+    wave: WaveScratch,
+}
+
+/// The [`TileScratch`]es of a pass, lent to one tile at a time, so that a thread
+/// allocates and grows its buffers once a pass rather than once a tile (at 16x16 pixels
+/// and a few samples a pixel, a tile's own work is not much larger than growing them).
+#[derive(Default)]
+struct ScratchPool(Mutex<Vec<TileScratch>>);
+
+impl ScratchPool {
+    /// Runs `f` with a scratch no other tile holds, and takes it back after.
+    fn lend<T>(&self, f: impl FnOnce(&mut TileScratch) -> T) -> T {
+        // A poisoned pool is a panic elsewhere, already on its way out: lend a fresh one.
+        let taken = self.0.lock().ok().and_then(|mut pool| pool.pop());
+        let mut scratch = taken.unwrap_or_default();
+        let out = f(&mut scratch);
+        if let Ok(mut pool) = self.0.lock() {
+            pool.push(scratch);
+        }
+        out
+    }
+}
+
 /// The tile at `origin` of the film of `bounds`; `None` when cancelled.
 fn render_tile(
     estimator: &Estimator<'_>,
-    bounds: PixelBounds,
-    origin: UVec2,
+    (bounds, origin): (PixelBounds, UVec2),
     pass_blocks: &[Range<u32>],
     cancel: &AtomicBool,
+    scratch: &mut TileScratch,
 ) -> Option<TileResult> {
     let samples = pass_blocks[0].start..pass_blocks[pass_blocks.len() - 1].end;
     let settings = estimator.settings;
@@ -368,11 +410,15 @@ fn render_tile(
     };
     let mut counters = RayCounters::default();
     let wave = estimator.scene.execution().wave.max(1);
-    let (mut ids, mut rays) = (Vec::with_capacity(wave), Vec::with_capacity(wave));
     // Each path keeps its own copy of the sampler, positioned past its camera dimensions,
     // so that its vertices are reached from where it stands.
-    let mut samplers = Vec::with_capacity(wave);
-    let (mut estimates, mut scratch) = (Vec::with_capacity(wave), WaveScratch::default());
+    let TileScratch {
+        ids,
+        rays,
+        samplers,
+        estimates,
+        wave: scratch,
+    } = scratch;
     let camera = &estimator.scene.scene().camera;
     let pixels =
         (origin.y..origin.y + th).flat_map(|y| (origin.x..origin.x + tw).map(move |x| [x, y]));
@@ -397,14 +443,14 @@ fn render_tile(
         }
         radiance_wave(
             estimator,
-            &rays,
-            &ids,
-            &mut samplers,
+            rays,
+            ids,
+            samplers,
             &mut counters,
-            &mut scratch,
-            &mut estimates,
+            scratch,
+            estimates,
         );
-        for (id, &l) in ids.iter().zip(&estimates) {
+        for (id, &l) in ids.iter().zip(&*estimates) {
             tile.push(*id, l);
         }
     }
