@@ -75,7 +75,39 @@ pub struct Sampler {
     /// stream (`u64::MAX` before any pixel), so that a later dimension of the same
     /// sample is reached by advancing the difference, not the whole way again.
     stream_position: u64,
+    /// For the independent kind: the sample index `rng` last started in its pixel, with
+    /// the generator's state at that sample's dimension 0 (`None` before any), from which
+    /// any dimension of that sample, and the start of the next one, are reached in a few
+    /// steps.
+    sample_start: Option<(u32, u64)>,
 }
+
+/// The multiplier of the LCG under `rand_pcg`'s `Pcg32` (PCG's 64-bit default).
+const PCG_MULTIPLIER: u64 = 6_364_136_223_846_793_005;
+
+/// `(a, g)` such that `delta` steps of the LCG `s -> PCG_MULTIPLIER s + inc` take `s`
+/// to `a s + g inc` (mod 2^64), whatever `inc`: Brown's jump ("Random Number Generation
+/// with Arbitrary Strides", 1994), the one `Pcg32::advance` takes, with the increment
+/// factored out (the jump's constant term is linear in it).
+const fn lcg_jump(mut delta: u64) -> (u64, u64) {
+    let (mut acc_mult, mut acc_plus) = (1u64, 0u64);
+    let (mut cur_mult, mut cur_plus) = (PCG_MULTIPLIER, 1u64);
+    while delta > 0 {
+        if delta & 1 != 0 {
+            acc_mult = acc_mult.wrapping_mul(cur_mult);
+            acc_plus = acc_plus.wrapping_mul(cur_mult).wrapping_add(cur_plus);
+        }
+        cur_plus = cur_mult.wrapping_add(1).wrapping_mul(cur_plus);
+        cur_mult = cur_mult.wrapping_mul(cur_mult);
+        delta /= 2;
+    }
+    (acc_mult, acc_plus)
+}
+
+/// The jump from one sample's dimension 0 to the next's, made at compile time: the
+/// independent kind's step from sample to sample of a pixel, which `Pcg32::advance`
+/// would take in 16 rounds of its loop.
+const SAMPLE_JUMP: (u64, u64) = lcg_jump(DIMENSIONS_PER_SAMPLE as u64);
 
 /// splitmix64's output function (Steele, Lea and Flood 2014; constants from
 /// Stafford's "Mix13"): a bijective 64-bit mixer with good avalanche.
@@ -238,6 +270,7 @@ impl Sampler {
             reversed_index: 0,
             rng: Pcg32::new(0, 0),
             stream_position: u64::MAX,
+            sample_start: None,
         };
         sampler.start_pixel_sample([0, 0], 0, 0);
         sampler
@@ -284,22 +317,54 @@ impl Sampler {
             self.reversed_index = self.index.reverse_bits();
         } else {
             self.index = sample_index;
-            let position =
-                u64::from(sample_index) * u64::from(DIMENSIONS_PER_SAMPLE) + u64::from(dimension);
-            // The stream is the pixel's; a position ahead on it is reached from where the
-            // generator stands (an LCG's jumps compose exactly), which costs a few steps
-            // for the next vertex of a path instead of a jump of `index * 2^16`.
-            if same_pixel && self.stream_position <= position {
-                self.rng.advance(position - self.stream_position);
-            } else {
-                let key = pixel_key(pixel);
+            self.start_independent(same_pixel, sample_index, dimension);
+        }
+    }
+
+    /// [`Sampler::start_pixel_sample`] for the independent kind, on the pixel's stream.
+    /// Every position is reached from one the generator has stood at (an LCG's jumps
+    /// compose exactly): a later dimension of the sample from where it stands, an
+    /// earlier one from the sample's start, the next sample from this one's start by
+    /// [`SAMPLE_JUMP`], and only a new pixel from the stream's beginning.
+    #[inline]
+    fn start_independent(&mut self, same_pixel: bool, sample_index: u32, dimension: u32) {
+        let start = u64::from(sample_index) * u64::from(DIMENSIONS_PER_SAMPLE);
+        let position = start + u64::from(dimension);
+        let started = if same_pixel { self.sample_start } else { None };
+        match started {
+            Some((index, _)) if index == sample_index && self.stream_position <= position => {}
+            Some((index, state)) if index == sample_index => {
+                self.rng = Pcg32::from_state(state, self.rng.stream());
+                self.stream_position = start;
+            }
+            Some((index, state)) if index.checked_add(1) == Some(sample_index) => {
+                let stream = self.rng.stream();
+                let (a, g) = SAMPLE_JUMP;
+                let increment = (stream << 1) | 1;
+                let state = a
+                    .wrapping_mul(state)
+                    .wrapping_add(g.wrapping_mul(increment));
+                self.rng = Pcg32::from_state(state, stream);
+                self.stream_position = start;
+            }
+            Some(_) if self.stream_position <= start => {
+                self.rng.advance(start - self.stream_position);
+                self.stream_position = start;
+            }
+            _ => {
+                let key = pixel_key(self.pixel);
                 let stream = mix64(key ^ mix64(self.seed.wrapping_add(0x9e37_79b9_7f4a_7c15)));
                 // pbrt-v4's RNG::SetSequence(seq) is Pcg32::new(MixBits(seq), seq).
                 self.rng = Pcg32::new(mix64(stream), stream);
-                self.rng.advance(position);
+                self.rng.advance(start);
+                self.stream_position = start;
             }
-            self.stream_position = position;
         }
+        if self.stream_position == start {
+            self.sample_start = Some((sample_index, self.rng.state()));
+        }
+        self.rng.advance(position - self.stream_position);
+        self.stream_position = position;
     }
 
     /// The next uniform number, in `[0, 1)`: a multiple of `2^-24`, so 1.0 is
