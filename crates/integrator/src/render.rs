@@ -410,8 +410,6 @@ fn render_tile(
     };
     let mut counters = RayCounters::default();
     let wave = estimator.scene.execution().wave.max(1);
-    // Each path keeps its own copy of the sampler, positioned past its camera dimensions,
-    // so that its vertices are reached from where it stands.
     let TileScratch {
         ids,
         rays,
@@ -435,6 +433,8 @@ fn render_tile(
         for id in pixel_samples.by_ref().take(wave) {
             sampler.start_pixel_sample(id.pixel, id.index, 0);
             let jitter = sampler.next_2d();
+            // Each path keeps its own copy of the sampler, positioned past its camera
+            // dimensions, so that its vertices are reached from where it stands.
             samplers.push(sampler.clone());
             debug_assert_eq!(CAMERA_DIMS, 2);
             let film_point = glam::Vec2::new(id.pixel[0] as f32, id.pixel[1] as f32) + jitter;
