@@ -87,7 +87,7 @@ pub use stratified::strata_shape;
 /// constructions by definition, and dependencies point one way (the sampler
 /// depends on this crate, never the reverse).
 pub mod construct {
-    pub use super::hash::{hash_key, hash2, hash2_keyed, hash3, kensler_unit, permute};
+    pub use super::hash::{hash_key, hash2, hash2_keyed, hash3, kensler_unit, mix64, permute};
     pub use super::kronecker::increments as kronecker_increments;
     pub use super::pmj02::{PMJ02_TABLE_LEN, PMJ02_TABLES, pmj02_table_point};
     pub use super::stratified::{cmj, jittered_2d, latin_hypercube};

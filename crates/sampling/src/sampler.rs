@@ -6,7 +6,8 @@ use rand_pcg::Pcg32;
 use rand_pcg::rand_core::Rng;
 
 use lueur_pointsets::construct::{
-    PMJ02_TABLE_LEN, PMJ02_TABLES, cmj, hash_key, hash2, hash2_keyed, permute, pmj02_table_point,
+    PMJ02_TABLE_LEN, PMJ02_TABLES, cmj, hash_key, hash2, hash2_keyed, mix64, permute,
+    pmj02_table_point,
 };
 use lueur_pointsets::{
     HALTON_MAX_DIMENSIONS, SOBOL_MAX_DIMENSIONS, halton_base, laine_karras_permutation,
@@ -108,15 +109,6 @@ const fn lcg_jump(mut delta: u64) -> (u64, u64) {
 /// independent kind's step from sample to sample of a pixel, which `Pcg32::advance`
 /// would take in 16 rounds of its loop.
 const SAMPLE_JUMP: (u64, u64) = lcg_jump(DIMENSIONS_PER_SAMPLE as u64);
-
-/// splitmix64's output function (Steele, Lea and Flood 2014; constants from
-/// Stafford's "Mix13"): a bijective 64-bit mixer with good avalanche.
-#[inline]
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
 
 /// The 64-bit key of a pixel that the per-pixel hashes start from.
 #[inline]
