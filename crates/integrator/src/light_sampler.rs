@@ -5,8 +5,9 @@
 
 use glam::{Vec2, Vec3};
 use lueur_sampling::{
-    DirectionSample, DiscreteDistribution, Frame, RectangleFrame, SphericalRectangle,
-    cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_sphere_light_lanes,
+    DirectionSample, DiscreteDistribution, Frame, RECTANGLE_LANES, RectangleFrame,
+    SphericalRectangles, cosine_hemisphere_pdf, sample_cosine_hemisphere,
+    sample_sphere_light_lanes,
 };
 use lueur_sdf_math::{Lane, LaneKernel, LaneVec3, MAX_LANES, SimdLevel, write_lane};
 
@@ -223,16 +224,18 @@ impl Emitters<'_> {
 }
 
 /// The rectangle lights' direction samples that a wave's next-event estimation asks for,
-/// drawn one after another in a loop of their own, each through its light's frame. One
-/// sample is a chain of about 300 cycles of f64 square roots, divisions and trigonometry
-/// that the next statement of the shading waits on; a loop of nothing else lets the
-/// processor run the next sample's chain while the last one's finishes.
+/// drawn together, four requests to a vector of `f64` lanes
+/// ([`RectangleFrame::seen_from_lanes`], [`SphericalRectangle::sample_lanes`]): each is the
+/// bits [`Emitters::sample`] would draw for it alone, whatever its company. One sample is a
+/// chain of about 300 cycles of f64 square roots, divisions and trigonometry; in lanes, a
+/// vector of them costs about what one does.
 #[derive(Debug, Default)]
 pub(crate) struct RectangleDraws {
     /// Per request: the shading point, `u` and the light.
     requests: Vec<(Vec3, Vec2, usize)>,
-    /// Per request, while it is drawn: the light seen from its point.
-    seen: Vec<Option<SphericalRectangle>>,
+    /// Per group of [`RECTANGLE_LANES`] requests, while they are drawn: the lights seen
+    /// from their points.
+    seen: Vec<SphericalRectangles>,
     /// Per request, after [`RectangleDraws::draw`]: its sample.
     pub drawn: Vec<Option<DirectionSample>>,
 }
@@ -254,23 +257,31 @@ impl RectangleDraws {
 
     /// Draws every request's sample: what [`Emitters::sample`] would draw for it. The
     /// rectangles seen from every point first, then every sample: a loop of both would
-    /// be too long for the processor to start one request's chain before the last one's
-    /// ends.
+    /// be too long for the processor to start one group's chain before the last one's
+    /// ends. A short last group repeats its last request in the lanes it lacks.
     pub fn draw(&mut self, emitters: &Emitters<'_>) {
         let frame = |light| emitters.rectangle(light).expect("requests name rectangles");
         self.seen.clear();
-        self.seen.extend(
-            self.requests
-                .iter()
-                .map(|&(p, _, light)| frame(light).seen_from(p)),
-        );
+        self.seen
+            .extend(self.requests.chunks(RECTANGLE_LANES).map(|group| {
+                let request = |i: usize| group[i.min(group.len() - 1)];
+                RectangleFrame::seen_from_lanes(
+                    std::array::from_fn(|i| frame(request(i).2)),
+                    std::array::from_fn(|i| request(i).0),
+                )
+            }));
         self.drawn.clear();
-        self.drawn.extend(
-            self.requests
-                .iter()
-                .zip(&self.seen)
-                .map(|(&(p, u, light), seen)| frame(light).sample_seen(seen.as_ref(), p, u)),
-        );
+        for (group, seen) in self.requests.chunks(RECTANGLE_LANES).zip(&self.seen) {
+            let drawn = seen.sample(std::array::from_fn(|i| group[i.min(group.len() - 1)].1));
+            // The lanes whose light has no spherical rectangle from their point are
+            // sampled by area, alone.
+            for (i, (&(p, u, light), drawn)) in group.iter().zip(drawn).enumerate() {
+                self.drawn.push(match seen.exists(i) {
+                    true => drawn,
+                    false => frame(light).sample_seen(None, p, u),
+                });
+            }
+        }
     }
 }
 

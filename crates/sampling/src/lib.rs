@@ -24,8 +24,11 @@
 //! [`sample_sphere_light`] gives, and [`sample_cosine_hemisphere_lanes`] those of
 //! [`sample_cosine_hemisphere`]. Their sines and cosines are our own polynomial
 //! (`math.rs`), not libm's, which has no vector form to match. The spherical
-//! rectangle, scalar and in f64, takes its `atan2` and `sincos` from the `libm`
-//! crate, which gives the same bits on every platform.
+//! rectangle is written once over four `f64` lanes ([`SphericalRectangles`], `wide`'s
+//! `f64x4`, with its `atan2` and `sin_cos`), and [`SphericalRectangle`] is one lane of
+//! it. `wide` chooses its instructions when it is compiled, so every dispatch level of a
+//! binary gives the same bits; a build for another CPU (`-C target-cpu`, where `wide`
+//! then fuses multiply-adds) or another architecture may round differently.
 //!
 //! **Contract.** Every warp's samples follow its pdf (checked by chi-square
 //! goodness-of-fit tests); every pdf is finite and `>= 0`; no NaN or infinity
@@ -87,8 +90,8 @@ pub use light::{DirectionSample, DirectionSampleLanes};
 pub use math::ONE_MINUS_EPSILON;
 pub use mis::{balance_heuristic, power_heuristic};
 pub use quad_light::{
-    RectangleFrame, SphericalRectangle, polygon_irradiance, quad_area_pdf, quad_solid_angle_pdf,
-    sample_quad_area, sample_quad_solid_angle,
+    RECTANGLE_LANES, RectangleFrame, SphericalRectangle, SphericalRectangles, polygon_irradiance,
+    quad_area_pdf, quad_solid_angle_pdf, sample_quad_area, sample_quad_solid_angle,
 };
 pub use sampler::{DIMENSIONS_PER_SAMPLE, Sampler};
 pub use sampler_kind::SamplerKind;

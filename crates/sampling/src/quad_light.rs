@@ -10,6 +10,7 @@
 use std::f64::consts::TAU;
 
 use glam::{DVec3, Vec2, Vec3};
+use wide::f64x4;
 
 use crate::light::DirectionSample;
 use crate::math::{clamp_u2, normalize_with_length};
@@ -131,29 +132,41 @@ pub fn quad_area_pdf(p: Vec3, corner: Vec3, edge_u: Vec3, edge_v: Vec3, wi: Vec3
 /// of the last two gives without trigonometry.
 #[derive(Clone, Copy, Debug)]
 pub struct SphericalRectangle {
-    o: DVec3,
-    x: DVec3,
-    y: DVec3,
-    z: DVec3,
-    z0: f64,
-    x0: f64,
-    y0: f64,
-    x1: f64,
-    y1: f64,
-    b0: f64,
-    b1: f64,
+    /// The rectangle in every lane: the scalar functions are the lanes' in one lane.
+    lanes: SphericalRectangles,
+}
+
+/// Four [`SphericalRectangle`]s, a lane of `f64x4` each, from
+/// [`RectangleFrame::seen_from_lanes`]: the lanes where [`SphericalRectangles::exists`]
+/// is false hold values to be ignored.
+#[derive(Clone, Copy, Debug)]
+pub struct SphericalRectangles {
+    o: DVec3Lanes,
+    x: DVec3Lanes,
+    y: DVec3Lanes,
+    z: DVec3Lanes,
+    z0: f64x4,
+    x0: f64x4,
+    y0: f64x4,
+    x1: f64x4,
+    y1: f64x4,
+    b0: f64x4,
+    b1: f64x4,
     /// `1 - b0^2`, in a form that does not cancel.
-    one_minus_b0_squared: f64,
+    one_minus_b0_squared: f64x4,
     /// `cos k` and `sin k` of the paper's `k = 2pi - g2 - g3`.
-    cos_k: f64,
-    sin_k: f64,
-    solid_angle: f64,
-    normal: Vec3,
+    cos_k: f64x4,
+    sin_k: f64x4,
+    solid_angle: f64x4,
+    normal: [Vec3; RECTANGLE_LANES],
+    /// Bit `i`: lane `i` holds a rectangle.
+    exists: u8,
 }
 
 /// A complex number as `(re, im)`.
-type Complex = (f64, f64);
+type Complex = (f64x4, f64x4);
 
+#[inline(always)]
 fn times((a, b): Complex, (c, d): Complex) -> Complex {
     (a * c - b * d, a * d + b * c)
 }
@@ -182,14 +195,14 @@ impl SphericalRectangle {
 
     /// Solid angle of the rectangle seen from the shading point, in sr.
     pub fn solid_angle(&self) -> f32 {
-        self.solid_angle as f32
+        self.lanes.solid_angle.as_array()[0] as f32
     }
 
     /// The constant solid-angle pdf `1 / solid_angle` of [`Self::sample`] for
     /// directions that hit the rectangle (finite: the solid angle is at least
     /// [`Self::MIN_SOLID_ANGLE`]).
     pub fn pdf(&self) -> f32 {
-        (1.0 / self.solid_angle) as f32
+        (1.0 / self.lanes.solid_angle.as_array()[0]) as f32
     }
 
     /// Samples a direction uniformly in solid angle over the rectangle
@@ -197,54 +210,176 @@ impl SphericalRectangle {
     /// sub-rectangle `[x0, xu]` with solid angle `u.x S`, `u.y` picks the
     /// height along the resulting vertical edge uniformly in the projected
     /// coordinate `h`. `None` only if rounding defeats the invariant of
-    /// [`DirectionSample`].
+    /// [`DirectionSample`]. The one-lane instance of
+    /// [`SphericalRectangles::sample`], bit for bit.
     #[inline]
     pub fn sample(&self, u: Vec2) -> Option<DirectionSample> {
-        let u = clamp_u2(u).as_dvec2();
+        let [sample, ..] = self.lanes.sample([u; RECTANGLE_LANES]);
+        sample
+    }
+}
+
+impl SphericalRectangles {
+    /// Whether lane `i` holds a rectangle: what [`RectangleFrame::seen_from`] gives
+    /// for its light and point is not `None`.
+    #[inline]
+    pub fn exists(&self, i: usize) -> bool {
+        self.exists >> i & 1 == 1
+    }
+
+    /// [`SphericalRectangle::sample`] in each lane, with that lane's `u`: every lane
+    /// gives the bits the one-lane call gives for it, whatever the other lanes hold.
+    /// Lanes without a rectangle give values to be ignored.
+    pub fn sample(&self, u: [Vec2; RECTANGLE_LANES]) -> [Option<DirectionSample>; RECTANGLE_LANES] {
+        let Self {
+            o,
+            x,
+            y,
+            z,
+            z0,
+            x0,
+            y0,
+            x1,
+            y1,
+            b0,
+            b1,
+            one_minus_b0_squared,
+            cos_k,
+            sin_k,
+            solid_angle,
+            normal,
+            ..
+        } = *self;
+        let (ux, uy) = (
+            lanes(|i| f64::from(clamp_u2(u[i]).x)),
+            lanes(|i| f64::from(clamp_u2(u[i]).y)),
+        );
         // au = u.x S + k, by the angle-sum formulas.
-        let (sin_us, cos_us) = libm::sincos(u.x * self.solid_angle);
-        let cos_au = cos_us * self.cos_k - sin_us * self.sin_k;
-        let sin_au = sin_us * self.cos_k + cos_us * self.sin_k;
-        let fu = (cos_au * self.b0 - self.b1) / sin_au;
+        let (sin_us, cos_us) = (ux * solid_angle).sin_cos();
+        let cos_au = cos_us * cos_k - sin_us * sin_k;
+        let sin_au = sin_us * cos_k + cos_us * sin_k;
+        let fu = (cos_au * b0 - b1) / sin_au;
         // The paper's xu = -cu z0 / sqrt(1 - cu^2) with cu = sign(fu) / sqrt(fu^2 +
         // b0^2) is sign(fu) |z0| / sqrt(fu^2 - (1 - b0^2)): one square root and one
         // division fewer on the chain, and no cancellation in 1 - cu^2. Where the
         // root is 0 or rounding makes it imaginary, cu is +-1 and xu is the edge
         // of the rectangle on fu's side (pbrt-v4 keeps cu off +-1 for the same
         // end); then xu is clamped into the rectangle.
-        let g = fu * fu - self.one_minus_b0_squared;
-        let xu = if g > 0.0 {
-            (-self.z0).copysign(fu) / g.sqrt()
-        } else {
-            f64::INFINITY.copysign(fu)
-        };
-        let xu = xu.clamp(self.x0, self.x1);
-        let d = (xu * xu + self.z0 * self.z0).sqrt();
-        let h0 = self.y0 / (d * d + self.y0 * self.y0).sqrt();
-        let h1 = self.y1 / (d * d + self.y1 * self.y1).sqrt();
-        let hv = h0 + u.y * (h1 - h0);
+        let g = fu * fu - one_minus_b0_squared;
+        let sign = fu & f64x4::splat(-0.0);
+        let xu = g
+            .simd_gt(f64x4::ZERO)
+            .select((-z0 | sign) / g.sqrt(), f64x4::splat(f64::INFINITY) | sign);
+        let xu = xu.max(x0).min(x1);
+        let d2 = xu * xu + z0 * z0;
+        let d = d2.sqrt();
+        let h0 = y0 / (d2 + y0 * y0).sqrt();
+        let h1 = y1 / (d2 + y1 * y1).sqrt();
+        let hv = h0 + uy * (h1 - h0);
         let hv2 = hv * hv;
-        let yv = if hv2 < 1.0 - 1e-12 {
-            (hv * d / (1.0 - hv2).sqrt()).clamp(self.y0, self.y1)
-        } else {
-            self.y1
-        };
-        let local = xu * self.x + yv * self.y + self.z0 * self.z;
-        let distance = local.length();
-        let sample = DirectionSample {
-            wi: (local / distance).as_vec3(),
-            distance: distance as f32,
-            pdf: self.pdf(),
-            point: (self.o + local).as_vec3(),
-            normal: self.normal,
-        };
-        let ok = sample.wi.is_finite()
-            && sample.point.is_finite()
-            && sample.distance.is_finite()
-            && sample.distance > 0.0
-            && sample.pdf.is_finite()
-            && sample.pdf > 0.0;
-        ok.then_some(sample)
+        let yv = hv2
+            .simd_lt(f64x4::splat(1.0 - 1e-12))
+            .select((hv * d / (f64x4::ONE - hv2).sqrt()).max(y0).min(y1), y1);
+        let local = x * xu + y * yv + z * z0;
+        let distance = local.dot(local).sqrt();
+        let wi = local * (f64x4::ONE / distance);
+        let point = o + local;
+        let (pdf, distance) = ((f64x4::ONE / solid_angle).to_array(), distance.to_array());
+        std::array::from_fn(|i| {
+            let sample = DirectionSample {
+                wi: wi.lane(i).as_vec3(),
+                distance: distance[i] as f32,
+                pdf: pdf[i] as f32,
+                point: point.lane(i).as_vec3(),
+                normal: normal[i],
+            };
+            let ok = sample.wi.is_finite()
+                && sample.point.is_finite()
+                && sample.distance.is_finite()
+                && sample.distance > 0.0
+                && sample.pdf.is_finite()
+                && sample.pdf > 0.0;
+            ok.then_some(sample)
+        })
+    }
+}
+
+/// The lanes the spherical rectangle is computed in: `f64x4`'s.
+pub const RECTANGLE_LANES: usize = 4;
+
+/// An `f64x4` whose lane `i` is `f(i)`.
+#[inline(always)]
+fn lanes(f: impl Fn(usize) -> f64) -> f64x4 {
+    f64x4::new(std::array::from_fn(f))
+}
+
+/// Four `DVec3`, a lane each.
+#[derive(Clone, Copy, Debug)]
+struct DVec3Lanes {
+    x: f64x4,
+    y: f64x4,
+    z: f64x4,
+}
+
+impl DVec3Lanes {
+    #[inline(always)]
+    fn gather(f: impl Fn(usize) -> DVec3) -> Self {
+        let v: [DVec3; RECTANGLE_LANES] = std::array::from_fn(f);
+        Self {
+            x: lanes(|i| v[i].x),
+            y: lanes(|i| v[i].y),
+            z: lanes(|i| v[i].z),
+        }
+    }
+
+    #[inline(always)]
+    fn dot(self, o: Self) -> f64x4 {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    #[inline(always)]
+    fn lane(self, i: usize) -> DVec3 {
+        DVec3::new(
+            self.x.as_array()[i],
+            self.y.as_array()[i],
+            self.z.as_array()[i],
+        )
+    }
+}
+
+impl std::ops::Add for DVec3Lanes {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        Self {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+}
+
+impl std::ops::Sub for DVec3Lanes {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        Self {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+}
+
+impl std::ops::Mul<f64x4> for DVec3Lanes {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, s: f64x4) -> Self {
+        Self {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
     }
 }
 
@@ -303,34 +438,35 @@ impl RectangleFrame {
     }
 
     /// The spherical rectangle of the light seen from `p`: [`SphericalRectangle::new`],
-    /// which says when there is none.
+    /// which says when there is none. The one-lane instance of
+    /// [`RectangleFrame::seen_from_lanes`], bit for bit.
     #[inline]
     pub fn seen_from(&self, p: Vec3) -> Option<SphericalRectangle> {
-        if !p.is_finite() {
-            return None;
-        }
-        let Self {
-            corner,
-            x,
-            y,
-            z,
-            width,
-            height,
-            normal,
-            ..
-        } = *self;
-        let o = p.as_dvec3();
-        let d = corner.as_dvec3() - o;
-        let z0 = d.dot(z);
+        let lanes = Self::seen_from_lanes([self; RECTANGLE_LANES], [p; RECTANGLE_LANES]);
+        lanes.exists(0).then_some(SphericalRectangle { lanes })
+    }
+
+    /// [`RectangleFrame::seen_from`] for four lights and four points at once, a lane
+    /// each: every lane gives the bits the one-lane call gives for it, whatever the
+    /// other lanes hold.
+    pub fn seen_from_lanes(
+        frames: [&RectangleFrame; RECTANGLE_LANES],
+        points: [Vec3; RECTANGLE_LANES],
+    ) -> SphericalRectangles {
+        let o = DVec3Lanes::gather(|i| points[i].as_dvec3());
+        let (x, y, z) = (
+            DVec3Lanes::gather(|i| frames[i].x),
+            DVec3Lanes::gather(|i| frames[i].y),
+            DVec3Lanes::gather(|i| frames[i].z),
+        );
+        let d = DVec3Lanes::gather(|i| frames[i].corner.as_dvec3()) - o;
         // The emitting side is +z; p must be strictly in front, i.e. the
         // rectangle lies at z0 < 0 in the local frame, as the paper requires.
-        if z0.is_nan() || z0 >= 0.0 {
-            return None;
-        }
+        let z0 = d.dot(z);
         let x0 = d.dot(x);
         let y0 = d.dot(y);
-        let x1 = x0 + width;
-        let y1 = y0 + height;
+        let x1 = x0 + lanes(|i| frames[i].width);
+        let y1 = y0 + lanes(|i| frames[i].height);
         // The paper's great-circle normals through consecutive vertices
         // `(x_i, y_j, z0)` are, up to positive factors, n0 = (0, z0, -y0),
         // n1 = (-z0, 0, x1), n2 = (0, -z0, y1), n3 = (z0, 0, -x0). The interior
@@ -338,10 +474,10 @@ impl RectangleFrame {
         // and the cross product's length is |z0| times the distance to the vertex
         // the two circles share. In units of the largest coordinate, so that the
         // product of four stays far from overflow and underflow.
-        let unit = 1.0 / x0.abs().max(x1.abs()).max(y0.abs()).max(y1.abs()).max(-z0);
+        let unit = f64x4::ONE / x0.abs().max(x1.abs()).max(y0.abs()).max(y1.abs()).max(-z0);
         let (a0, a1, b0, b1, c) = (x0 * unit, x1 * unit, y0 * unit, y1 * unit, -z0 * unit);
         let c2 = c * c;
-        let to = |a: f64, b: f64| c * (a * a + b * b + c2).sqrt();
+        let to = |a: f64x4, b: f64x4| c * (a * a + b * b + c2).sqrt();
         let g0 = (b0 * a1, to(a1, b0));
         let g1 = (-a1 * b1, to(a1, b1));
         let g2 = (a0 * b1, to(a0, b1));
@@ -353,28 +489,27 @@ impl RectangleFrame {
         // angle in (0, 2pi): a negative argument is the solid angle less 2pi,
         // unless it is a rounding of a solid angle near 0 or near 2pi, which
         // cannot be told apart and are declined.
-        let angle = libm::atan2(im, re);
-        let solid_angle = if angle >= 0.0 {
-            angle
-        } else if angle < -1e-6 {
-            angle + TAU
-        } else {
-            return None;
-        };
-        if !(solid_angle.is_finite()
-            && solid_angle >= f64::from(SphericalRectangle::MIN_SOLID_ANGLE))
-        {
-            return None;
-        }
+        let angle = im.atan2(re);
+        let turned = angle.simd_lt(f64x4::ZERO);
+        let solid_angle = turned.select(angle + f64x4::splat(TAU), angle);
+        let told_apart = !turned | angle.simd_lt(f64x4::splat(-1e-6));
         // k = 2pi - (g2 + g3): cos k = cos(g2 + g3), sin k = -sin(g2 + g3).
         // Not `hypot`: the turns are in units of the largest coordinate, far from
-        // overflow, and glibc's `hypot` is a call.
+        // overflow.
         let length = (g23.0 * g23.0 + g23.1 * g23.1).sqrt();
         let (cos_k, sin_k) = (g23.0 / length, -g23.1 / length);
-        if !(cos_k.is_finite() && sin_k.is_finite()) {
-            return None;
-        }
-        Some(SphericalRectangle {
+        // The z components of the unit n0 and n2.
+        let b0_c2 = b0 * b0 + c2;
+        let (b0, b1) = (-b0 / b0_c2.sqrt(), b1 / (b1 * b1 + c2).sqrt());
+        let one_minus_b0_squared = c2 / b0_c2;
+        let valid = z0.simd_lt(f64x4::ZERO)
+            & told_apart
+            & solid_angle.is_finite()
+            & solid_angle.simd_ge(f64x4::splat(f64::from(SphericalRectangle::MIN_SOLID_ANGLE)))
+            & cos_k.is_finite()
+            & sin_k.is_finite();
+        let finite = (0..RECTANGLE_LANES).filter(|&i| points[i].is_finite());
+        SphericalRectangles {
             o,
             x,
             y,
@@ -384,15 +519,15 @@ impl RectangleFrame {
             y0,
             x1,
             y1,
-            // The z components of the unit n0 and n2.
-            b0: -b0 / (b0 * b0 + c2).sqrt(),
-            b1: b1 / (b1 * b1 + c2).sqrt(),
-            one_minus_b0_squared: c2 / (b0 * b0 + c2),
+            b0,
+            b1,
+            one_minus_b0_squared,
             cos_k,
             sin_k,
             solid_angle,
-            normal,
-        })
+            normal: frames.map(|frame| frame.normal),
+            exists: valid.to_bitmask() as u8 & finite.fold(0, |bits, i| bits | 1 << i),
+        }
     }
 
     /// [`sample_quad_solid_angle`] for this light: by solid angle where the
@@ -513,6 +648,53 @@ mod tests {
                 assert_eq!(quad_solid_angle_pdf(p, CORNER, EU, EV, s.wi), rect.pdf());
             }
         }
+    }
+
+    /// A lane's rectangle and sample are the one-lane call's, bit for bit, whatever the
+    /// other lanes hold: other lights, points behind the light or not finite, lights too
+    /// small to see. The renderer groups requests as its waves come, so an image would
+    /// otherwise depend on the grouping.
+    #[test]
+    fn every_lane_gives_the_one_lane_bits_whatever_its_company() {
+        let frames = [
+            RectangleFrame::new(CORNER, EU, EV).unwrap(),
+            RectangleFrame::new(Vec3::new(-0.3, 2.2, -0.3), 0.6 * Vec3::X, 0.6 * Vec3::Z).unwrap(),
+            RectangleFrame::new(Vec3::new(5e3, 0.0, 1.0), 1e-5 * Vec3::X, -1e-5 * Vec3::Y).unwrap(),
+        ];
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut with_rectangle, mut without) = (0, 0);
+        for round in 0..4000 {
+            let picks: [usize; RECTANGLE_LANES] = std::array::from_fn(|_| (next() * 3.0) as usize);
+            let points: [Vec3; RECTANGLE_LANES] = std::array::from_fn(|i| match (round + i) % 23 {
+                0 => Vec3::new(f32::NAN, 0.0, 0.0),
+                1 => Vec3::new(0.0, f32::INFINITY, 0.0),
+                _ => Vec3::new(next() - 0.5, next() * 3.0 - 0.5, next() * 2.0 - 1.0) * 4.0,
+            });
+            let u: [Vec2; RECTANGLE_LANES] = std::array::from_fn(|_| Vec2::new(next(), next()));
+            let seen = RectangleFrame::seen_from_lanes(picks.map(|k| &frames[k]), points);
+            let drawn = seen.sample(u);
+            for i in 0..RECTANGLE_LANES {
+                let frame = &frames[picks[i]];
+                let alone = frame.seen_from(points[i]);
+                assert_eq!(seen.exists(i), alone.is_some(), "round {round} lane {i}");
+                if let Some(alone) = alone {
+                    assert_eq!(drawn[i], alone.sample(u[i]), "round {round} lane {i}");
+                    with_rectangle += 1;
+                } else {
+                    without += 1;
+                }
+            }
+        }
+        assert!(
+            with_rectangle > 4000 && without > 4000,
+            "{with_rectangle} {without}"
+        );
     }
 
     #[test]
