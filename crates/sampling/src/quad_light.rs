@@ -230,6 +230,7 @@ impl SphericalRectangles {
     /// [`SphericalRectangle::sample`] in each lane, with that lane's `u`: every lane
     /// gives the bits the one-lane call gives for it, whatever the other lanes hold.
     /// Lanes without a rectangle give values to be ignored.
+    #[inline]
     pub fn sample(&self, u: [Vec2; RECTANGLE_LANES]) -> [Option<DirectionSample>; RECTANGLE_LANES] {
         let Self {
             o,
@@ -449,6 +450,7 @@ impl RectangleFrame {
     /// [`RectangleFrame::seen_from`] for four lights and four points at once, a lane
     /// each: every lane gives the bits the one-lane call gives for it, whatever the
     /// other lanes hold.
+    #[inline]
     pub fn seen_from_lanes(
         frames: [&RectangleFrame; RECTANGLE_LANES],
         points: [Vec3; RECTANGLE_LANES],
