@@ -232,25 +232,8 @@ impl SphericalRectangles {
     /// Lanes without a rectangle give values to be ignored.
     #[inline]
     pub fn sample(&self, u: [Vec2; RECTANGLE_LANES]) -> [Option<DirectionSample>; RECTANGLE_LANES] {
-        let Self {
-            o,
-            x,
-            y,
-            z,
-            z0,
-            x0,
-            y0,
-            x1,
-            y1,
-            b0,
-            b1,
-            one_minus_b0_squared,
-            cos_k,
-            sin_k,
-            solid_angle,
-            normal,
-            ..
-        } = *self;
+        let (solid_angle, cos_k, sin_k) = (self.solid_angle, self.cos_k, self.sin_k);
+        let (z0, x0, x1, y0, y1) = (self.z0, self.x0, self.x1, self.y0, self.y1);
         let (ux, uy) = (
             lanes(|i| f64::from(clamp_u2(u[i]).x)),
             lanes(|i| f64::from(clamp_u2(u[i]).y)),
@@ -259,14 +242,14 @@ impl SphericalRectangles {
         let (sin_us, cos_us) = (ux * solid_angle).sin_cos();
         let cos_au = cos_us * cos_k - sin_us * sin_k;
         let sin_au = sin_us * cos_k + cos_us * sin_k;
-        let fu = (cos_au * b0 - b1) / sin_au;
+        let fu = (cos_au * self.b0 - self.b1) / sin_au;
         // The paper's xu = -cu z0 / sqrt(1 - cu^2) with cu = sign(fu) / sqrt(fu^2 +
         // b0^2) is sign(fu) |z0| / sqrt(fu^2 - (1 - b0^2)): one square root and one
         // division fewer on the chain, and no cancellation in 1 - cu^2. Where the
         // root is 0 or rounding makes it imaginary, cu is +-1 and xu is the edge
         // of the rectangle on fu's side (pbrt-v4 keeps cu off +-1 for the same
         // end); then xu is clamped into the rectangle.
-        let g = fu * fu - one_minus_b0_squared;
+        let g = fu * fu - self.one_minus_b0_squared;
         let sign = fu & f64x4::splat(-0.0);
         let xu = g
             .simd_gt(f64x4::ZERO)
@@ -281,10 +264,10 @@ impl SphericalRectangles {
         let yv = hv2
             .simd_lt(f64x4::splat(1.0 - 1e-12))
             .select((hv * d / (f64x4::ONE - hv2).sqrt()).max(y0).min(y1), y1);
-        let local = x * xu + y * yv + z * z0;
+        let local = self.x * xu + self.y * yv + self.z * z0;
         let distance = local.dot(local).sqrt();
         let wi = local * (f64x4::ONE / distance);
-        let point = o + local;
+        let point = self.o + local;
         let (pdf, distance) = ((f64x4::ONE / solid_angle).to_array(), distance.to_array());
         std::array::from_fn(|i| {
             let sample = DirectionSample {
@@ -292,7 +275,7 @@ impl SphericalRectangles {
                 distance: distance[i] as f32,
                 pdf: pdf[i] as f32,
                 point: point.lane(i).as_vec3(),
-                normal: normal[i],
+                normal: self.normal[i],
             };
             let ok = sample.wi.is_finite()
                 && sample.point.is_finite()
