@@ -225,10 +225,10 @@ impl Emitters<'_> {
 
 /// The rectangle lights' direction samples that a wave's next-event estimation asks for,
 /// drawn together, four requests to a vector of `f64` lanes
-/// ([`RectangleFrame::seen_from_lanes`], [`SphericalRectangle::sample_lanes`]): each is the
+/// ([`RectangleFrame::seen_from_lanes`], [`SphericalRectangles::sample`]): each is the
 /// bits [`Emitters::sample`] would draw for it alone, whatever its company. One sample is a
-/// chain of about 300 cycles of f64 square roots, divisions and trigonometry; in lanes, a
-/// vector of them costs about what one does.
+/// chain of about 300 cycles of f64 square roots, divisions and trigonometry; in lanes,
+/// two of its divisions or roots issue at once, and no call to libm waits on the last.
 #[derive(Debug, Default)]
 pub(crate) struct RectangleDraws {
     /// Per request: the shading point, `u` and the light.
@@ -276,9 +276,10 @@ impl RectangleDraws {
             // The lanes whose light has no spherical rectangle from their point are
             // sampled by area, alone.
             for (i, (&(p, u, light), drawn)) in group.iter().zip(drawn).enumerate() {
-                self.drawn.push(match seen.exists(i) {
-                    true => drawn,
-                    false => frame(light).sample_seen(None, p, u),
+                self.drawn.push(if seen.exists(i) {
+                    drawn
+                } else {
+                    frame(light).sample_seen(None, p, u)
                 });
             }
         }
