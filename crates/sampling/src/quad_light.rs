@@ -234,10 +234,8 @@ impl SphericalRectangles {
     pub fn sample(&self, u: [Vec2; RECTANGLE_LANES]) -> [Option<DirectionSample>; RECTANGLE_LANES] {
         let (solid_angle, cos_k, sin_k) = (self.solid_angle, self.cos_k, self.sin_k);
         let (z0, x0, x1, y0, y1) = (self.z0, self.x0, self.x1, self.y0, self.y1);
-        let (ux, uy) = (
-            lanes(|i| f64::from(clamp_u2(u[i]).x)),
-            lanes(|i| f64::from(clamp_u2(u[i]).y)),
-        );
+        let u = u.map(clamp_u2);
+        let (ux, uy) = (lanes(|i| f64::from(u[i].x)), lanes(|i| f64::from(u[i].y)));
         // au = u.x S + k, by the angle-sum formulas.
         let (sin_us, cos_us) = (ux * solid_angle).sin_cos();
         let cos_au = cos_us * cos_k - sin_us * sin_k;
