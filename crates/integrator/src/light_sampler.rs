@@ -138,7 +138,7 @@ impl Emitters<'_> {
         n: Vec3,
         u_choice: f32,
         u: Vec2,
-        drawn: Option<Option<DirectionSample>>,
+        drawn: Option<&Option<DirectionSample>>,
     ) -> Option<(EmitterSample, Option<usize>)> {
         let (emitter, pmf) = self.sampler.choose(u_choice)?;
         match emitter {
@@ -161,8 +161,13 @@ impl Emitters<'_> {
                 ))
             }
             Emitter::Light(i) => {
-                let drawn = drawn.or_else(|| self.rectangle(i).map(|frame| frame.sample(p, u)));
-                let s = self.lights[i].sample_drawn(p, u, self.quad_sampling, drawn)?;
+                let light = &self.lights[i];
+                let s = match (drawn, self.rectangle(i)) {
+                    (None, Some(frame)) => {
+                        light.sample_drawn(p, u, self.quad_sampling, Some(&frame.sample(p, u)))
+                    }
+                    (drawn, _) => light.sample_drawn(p, u, self.quad_sampling, drawn),
+                }?;
                 Some((
                     EmitterSample {
                         pdf: s.pdf * pmf,

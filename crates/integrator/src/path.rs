@@ -106,11 +106,11 @@ struct Path {
 
 /// A path shaded at a vertex, waiting for its shadow rays: the vertex, the shadow rays'
 /// contributions (`shadow` indexes the wave's shadow rays; the next-event ray, if any, is
-/// the last), and where the path goes next.
+/// the last), and where the path goes next. Its shading point is the wave's
+/// [`SurfacePoint`] of the same index.
 #[derive(Clone, Copy)]
 struct Shaded {
     path: usize,
-    surface: SurfacePoint,
     diffuse: bool,
     shadow: (usize, usize),
     next_event: bool,
@@ -122,7 +122,6 @@ impl Shaded {
     /// A placeholder for a slot that [`shade`] fills.
     const UNSET: Shaded = Shaded {
         path: 0,
-        surface: SurfacePoint::UNSET,
         diffuse: false,
         shadow: (0, 0),
         next_event: false,
@@ -131,13 +130,13 @@ impl Shaded {
     };
 }
 
-/// A vertex waiting to be shaded: its path, where it is, its numbers, where the wave drew
-/// its next-event estimation's light sample, and its direction's index in the wave's
-/// [`CosineDraws`] where it scatters by the cosine.
+/// A vertex waiting to be shaded: its path, the object it met, its numbers, where the wave
+/// drew its next-event estimation's light sample, and its direction's index in the wave's
+/// [`CosineDraws`] where it scatters by the cosine. Its shading point is the wave's
+/// [`SurfacePoint`] of the same index.
 struct Pending {
     path: usize,
     on_surface: SurfaceHit,
-    surface: SurfacePoint,
     u: VertexSample,
     light: Option<LightDraw>,
     cosine: Option<usize>,
@@ -172,10 +171,10 @@ impl LightDraws {
 
     /// The sample `light` names, drawn.
     #[inline(always)]
-    fn drawn(&self, light: LightDraw) -> Option<DirectionSample> {
+    fn drawn(&self, light: LightDraw) -> &Option<DirectionSample> {
         match light {
-            LightDraw::Sphere(k) => self.spheres.drawn[k],
-            LightDraw::Rectangle(k) => self.rectangles.drawn[k],
+            LightDraw::Sphere(k) => &self.spheres.drawn[k],
+            LightDraw::Rectangle(k) => &self.rectangles.drawn[k],
         }
     }
 }
@@ -214,14 +213,14 @@ fn material_at(scene: &PreparedScene, on_surface: SurfaceHit) -> Material {
     scene.scene().materials[scene.scene().objects[on_surface.object].material]
 }
 
-/// Shades the path of `pending` (`path`) where it met its surface: the shadow rays the
+/// Shades the path of `pending` (`path`) at its shading point `surface`: the shadow rays the
 /// vertex proposes (queued in `shadow`; at a diffuse vertex the delta lights', then
 /// next-event estimation's where the strategy uses it, its light sample taken from
 /// `lights` where the wave drew it) and the direction it scatters in.
 fn shade(
     estimator: &Estimator<'_>,
     lighting: &Lighting<'_>,
-    (pending, path): (&Pending, &Path),
+    (pending, surface, path): (&Pending, &SurfacePoint, &Path),
     (lights, cosines): (&LightDraws, &CosineDraws),
     shadow: &mut ShadowQueue,
     out: &mut Shaded,
@@ -232,7 +231,6 @@ fn shade(
     let &Pending {
         path: index,
         on_surface,
-        surface,
         ref u,
         light,
         cosine,
@@ -247,7 +245,6 @@ fn shade(
     // pushed is stored in pieces and loaded back whole, and the load waits for the stores
     // to retire (docs/PERFORMANCE.md, "Stores loaded whole").
     out.path = index;
-    out.surface = surface;
     out.roulette = u.roulette;
     let first = shadow.rays.len();
     match material {
@@ -391,23 +388,35 @@ pub(crate) fn radiance_wave(
             if path.depth >= settings.max_depth {
                 continue;
             }
-            let surface = *surfaces
+            let surface = surfaces
                 .next()
                 .expect("a shading point for each hit that scatters");
-            let u = VertexSample::draw(
+            // The numbers are drawn into their slot: a `VertexSample` returned whole is
+            // stored in pieces and loaded back whole (docs/PERFORMANCE.md, "Stores loaded
+            // whole").
+            s.pending.push(Pending {
+                path: i,
+                on_surface,
+                u: VertexSample::UNSET,
+                light: None,
+                cosine: None,
+            });
+            let pending = s.pending.last_mut().expect("pushed");
+            pending.u.draw(
                 &mut samplers[i],
                 ids[i].pixel,
                 ids[i].index,
                 path.depth,
                 settings.strategy,
             );
+            let u = &pending.u;
             // Next-event estimation toward a sphere or rectangle light, and the
             // cosine-weighted direction a diffuse vertex scatters in: drawn below, with the
             // wave's others.
             let diffuse = matches!(material_at(scene, on_surface), Material::Lambertian { .. });
             let next_event = strategy::uses_next_event(settings.strategy) && diffuse;
             let emitters = &lighting.emitters;
-            let light = if !next_event {
+            pending.light = if !next_event {
                 None
             } else if let Some(sphere) = emitters.chosen_sphere(u.emitter_choice) {
                 let k = s.lights.spheres.request(surface.p, sphere, u.emitter);
@@ -418,16 +427,8 @@ pub(crate) fn radiance_wave(
                     LightDraw::Rectangle(k)
                 })
             };
-            let cosine = (diffuse && strategy::scatters_by_cosine(settings.strategy))
+            pending.cosine = (diffuse && strategy::scatters_by_cosine(settings.strategy))
                 .then(|| s.cosines.request(u.bsdf));
-            s.pending.push(Pending {
-                path: i,
-                on_surface,
-                surface,
-                u,
-                light,
-                cosine,
-            });
         }
         s.lights.draw(tracing.simd, &lighting.emitters);
         s.cosines.draw(tracing.simd);
@@ -435,12 +436,12 @@ pub(crate) fn radiance_wave(
         s.shaded.resize(s.pending.len(), Shaded::UNSET);
         s.shadow.rays.clear();
         s.shadow.contributions.clear();
-        for (pending, out) in s.pending.iter().zip(&mut s.shaded) {
+        for ((pending, surface), out) in s.pending.iter().zip(&s.surfaces).zip(&mut s.shaded) {
             let path = &s.paths[pending.path];
             shade(
                 estimator,
                 &lighting,
-                (pending, path),
+                (pending, surface, path),
                 (&s.lights, &s.cosines),
                 &mut s.shadow,
                 out,
@@ -456,12 +457,12 @@ pub(crate) fn radiance_wave(
         );
 
         s.active.clear();
-        for shaded in &s.shaded {
+        for (shaded, surface) in s.shaded.iter().zip(&s.surfaces) {
             let path = &mut s.paths[shaded.path];
             if shaded.diffuse {
                 gather(path, shaded, &s.shadow.contributions, &s.free, settings);
             }
-            if scatter(path, shaded, &march, settings) {
+            if scatter(path, (shaded, surface), &march, settings) {
                 s.active.push(shaded.path);
             }
         }
@@ -498,9 +499,14 @@ fn gather(
     }
 }
 
-/// Moves the path past its vertex in the scattered direction, through Russian roulette;
-/// whether it goes on.
-fn scatter(path: &mut Path, shaded: &Shaded, march: &March, settings: &RenderSettings) -> bool {
+/// Moves the path past its vertex (at `surface`) in the scattered direction, through
+/// Russian roulette; whether it goes on.
+fn scatter(
+    path: &mut Path,
+    (shaded, surface): (&Shaded, &SurfacePoint),
+    march: &March,
+    settings: &RenderSettings,
+) -> bool {
     let Some(scatter) = shaded.scatter else {
         return false;
     };
@@ -509,7 +515,6 @@ fn scatter(path: &mut Path, shaded: &Shaded, march: &March, settings: &RenderSet
     if path.beta == Vec3::ZERO || !path.beta.is_finite() {
         return false;
     }
-    let surface = &shaded.surface;
     path.previous = Previous {
         in_solid: surface.inside
             && (path.depth == 1 && march.camera_inside || path.previous.in_solid),

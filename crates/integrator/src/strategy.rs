@@ -43,47 +43,55 @@ pub(crate) struct VertexSample {
 }
 
 impl VertexSample {
-    /// The numbers of vertex `depth` of sample `index` of `pixel` that `strategy` uses;
-    /// the others are skipped (left 0), which changes no number drawn: each has its
-    /// dimension whatever is drawn before it.
+    /// Every number 0: a slot for [`VertexSample::draw`] to fill.
+    pub const UNSET: VertexSample = VertexSample {
+        emitter_choice: 0.0,
+        emitter: Vec2::ZERO,
+        mixture: 0.0,
+        bsdf: Vec2::ZERO,
+        roulette: 0.0,
+    };
+
+    /// Draws into `self` the numbers of vertex `depth` of sample `index` of `pixel` that
+    /// `strategy` uses; the others are skipped (left 0), which changes no number drawn:
+    /// each has its dimension whatever is drawn before it. Filled in place, a field at a
+    /// time, as each number is drawn.
     #[inline]
     pub fn draw(
+        &mut self,
         sampler: &mut Sampler,
         pixel: [u32; 2],
         index: u32,
         depth: u32,
         strategy: Strategy,
-    ) -> VertexSample {
+    ) {
         sampler.start_pixel_sample(pixel, index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
-        let (emitter_choice, emitter) = if samples_emitters(strategy) {
-            (sampler.next_1d(), sampler.next_2d())
+        if samples_emitters(strategy) {
+            self.emitter_choice = sampler.next_1d();
+            self.emitter = sampler.next_2d();
         } else {
             sampler.skip(3);
-            (0.0, Vec2::ZERO)
-        };
-        let mixture = if strategy == Strategy::Mixture {
-            sampler.next_1d()
+            self.emitter_choice = 0.0;
+            self.emitter = Vec2::ZERO;
+        }
+        if strategy == Strategy::Mixture {
+            self.mixture = sampler.next_1d();
         } else {
             sampler.skip(1);
-            0.0
-        };
-        let bsdf = sampler.next_2d();
-        let roulette = sampler.next_1d();
-        VertexSample {
-            emitter_choice,
-            emitter,
-            mixture,
-            bsdf,
-            roulette,
+            self.mixture = 0.0;
         }
+        self.bsdf = sampler.next_2d();
+        self.roulette = sampler.next_1d();
     }
 }
 
 /// A scattering vertex as the strategies see it.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Vertex {
-    /// The shading point, its normal and where rays leave from.
-    pub at: SurfacePoint,
+pub(crate) struct Vertex<'a> {
+    /// The shading point, its normal and where rays leave from: borrowed from the wave's
+    /// shading points, since a copy made on the stack a field at a time and read back a
+    /// vector at a time waits for its stores (docs/PERFORMANCE.md, "Stores loaded whole").
+    pub at: &'a SurfacePoint,
     /// Unit direction toward where the path came from.
     pub wo: Vec3,
     /// What the surface is made of.
@@ -140,7 +148,7 @@ pub(crate) struct Scatter {
 }
 
 /// A delta bounce on a mirror, followed by every strategy.
-pub(crate) fn mirror(v: &Vertex, u_bsdf: Vec2) -> Option<Scatter> {
+pub(crate) fn mirror(v: &Vertex<'_>, u_bsdf: Vec2) -> Option<Scatter> {
     let s = v
         .material
         .sample(v.wo, v.at.n, u_bsdf, HemisphereSampling::Cosine)?;
@@ -158,7 +166,7 @@ pub(crate) fn mirror(v: &Vertex, u_bsdf: Vec2) -> Option<Scatter> {
 pub(crate) fn scatter(
     strategy: Strategy,
     emitters: &Emitters<'_>,
-    v: &Vertex,
+    v: &Vertex<'_>,
     u: &VertexSample,
     cosine: Option<Vec3>,
 ) -> Option<Scatter> {
@@ -179,7 +187,7 @@ pub(crate) fn scatter(
 pub(crate) fn scatter_into(
     strategy: Strategy,
     emitters: &Emitters<'_>,
-    v: &Vertex,
+    v: &Vertex<'_>,
     u: &VertexSample,
     cosine: Option<Vec3>,
     out: &mut Option<Scatter>,
@@ -195,7 +203,7 @@ pub(crate) fn scatter_into(
 fn scatter_out_of_line(
     strategy: Strategy,
     emitters: &Emitters<'_>,
-    v: &Vertex,
+    v: &Vertex<'_>,
     u: &VertexSample,
     cosine: Option<Vec3>,
     out: &mut Option<Scatter>,
@@ -318,7 +326,7 @@ pub(crate) fn uses_next_event(strategy: Strategy) -> bool {
 /// `uniform` and `cosine`: BSDF sampling over the hemisphere; emission found
 /// later counts in full.
 pub(crate) fn hemisphere(
-    v: &Vertex,
+    v: &Vertex<'_>,
     hemisphere: HemisphereSampling,
     u: Vec2,
     drawn: Option<Vec3>,
@@ -339,7 +347,7 @@ pub(crate) fn hemisphere(
 /// taken).
 pub(crate) fn toward_emitters(
     emitters: &Emitters<'_>,
-    v: &Vertex,
+    v: &Vertex<'_>,
     u_choice: f32,
     u: Vec2,
 ) -> Option<Scatter> {
@@ -351,7 +359,11 @@ pub(crate) fn toward_emitters(
 
 /// `mixture`: one-sample MIS, the uniform hemisphere or an emitter with
 /// probability 1/2 each, weighted by [`mixture_pdf`].
-pub(crate) fn mixture(emitters: &Emitters<'_>, v: &Vertex, u: &VertexSample) -> Option<Scatter> {
+pub(crate) fn mixture(
+    emitters: &Emitters<'_>,
+    v: &Vertex<'_>,
+    u: &VertexSample,
+) -> Option<Scatter> {
     let use_light = emitters.any() && u.mixture >= 0.5;
     let wi = if use_light {
         emitters
@@ -369,7 +381,7 @@ pub(crate) fn mixture(emitters: &Emitters<'_>, v: &Vertex, u: &VertexSample) -> 
 /// The pdf with which [`mixture`] picks `wi`: the average of the uniform
 /// hemisphere's and the emitters', or the hemisphere's alone without
 /// emitters.
-pub(crate) fn mixture_pdf(emitters: &Emitters<'_>, v: &Vertex, wi: Vec3) -> f32 {
+pub(crate) fn mixture_pdf(emitters: &Emitters<'_>, v: &Vertex<'_>, wi: Vec3) -> f32 {
     let hemisphere_pdf = v
         .material
         .pdf(v.wo, wi, v.at.n, HemisphereSampling::Uniform);
@@ -387,7 +399,7 @@ pub(crate) fn mixture_pdf(emitters: &Emitters<'_>, v: &Vertex, wi: Vec3) -> f32 
 /// Always inlined, as [`Material::sample_drawn`] is: out of line, its result comes back
 /// through memory, stored in pieces and loaded whole.
 #[inline(always)]
-pub(crate) fn mis_bsdf(v: &Vertex, u: Vec2, drawn: Option<Vec3>) -> Option<Scatter> {
+pub(crate) fn mis_bsdf(v: &Vertex<'_>, u: Vec2, drawn: Option<Vec3>) -> Option<Scatter> {
     let s = v
         .material
         .sample_drawn(v.wo, v.at.n, u, MIS_HEMISPHERE, drawn)?;
@@ -401,7 +413,7 @@ pub(crate) fn mis_bsdf(v: &Vertex, u: Vec2, drawn: Option<Vec3>) -> Option<Scatt
 
 /// A direction `wi` chosen with `pdf` by a strategy that does not sample the
 /// BSDF; `None` where it carries no weight.
-fn weighted(v: &Vertex, wi: Vec3, pdf: f32) -> Option<Scatter> {
+fn weighted(v: &Vertex<'_>, wi: Vec3, pdf: f32) -> Option<Scatter> {
     let n = v.at.n;
     let f = v.material.eval(v.wo, wi, n);
     if !(pdf > 0.0) || f == Vec3::ZERO {
@@ -439,7 +451,7 @@ impl<'a> Lighting<'a> {
     /// light can be reached no other way), pushed to `out` in the lights' order; the
     /// vertex gathers the sum of those whose ray is free, in that order.
     #[inline]
-    pub fn delta_lights(&self, v: &Vertex, out: &mut Vec<(ShadowRay, Vec3)>) {
+    pub fn delta_lights(&self, v: &Vertex<'_>, out: &mut Vec<(ShadowRay, Vec3)>) {
         let (n, wo) = (v.at.n, v.wo);
         for light in &self.scene.scene().lights {
             let Some((wi, irradiance)) = light.delta_arrival() else {
@@ -472,9 +484,9 @@ impl<'a> Lighting<'a> {
     #[inline]
     pub fn next_event(
         &self,
-        v: &Vertex,
+        v: &Vertex<'_>,
         u: &VertexSample,
-        drawn: Option<Option<DirectionSample>>,
+        drawn: Option<&Option<DirectionSample>>,
     ) -> Option<(ShadowRay, Vec3)> {
         let (n, wo) = (v.at.n, v.wo);
         let (es, light) =
@@ -542,14 +554,15 @@ mod tests {
     }
 
     /// A diffuse vertex at the origin facing +y, seen from above at a slant.
-    fn vertex() -> Vertex {
+    fn vertex() -> Vertex<'static> {
+        const AT: SurfacePoint = SurfacePoint {
+            p: Vec3::ZERO,
+            n: Vec3::Y,
+            origin: Vec3::new(0.0, 1e-5, 0.0),
+            inside: false,
+        };
         Vertex {
-            at: SurfacePoint {
-                p: Vec3::ZERO,
-                n: Vec3::Y,
-                origin: Vec3::Y * 1e-5,
-                inside: false,
-            },
+            at: &AT,
             wo: Vec3::new(0.3, 1.0, 0.2).normalize(),
             material: Material::Lambertian {
                 albedo: Vec3::splat(0.7),
@@ -680,7 +693,7 @@ mod tests {
                 let alone = scene.scene().lights[light].sample(p, e, quads);
                 assert_eq!(draws.drawn[k].map(|d| d.wi), alone.map(|s| s.wi), "{p} {e}");
                 let n = Vec3::Y;
-                let through = emitters.sample_drawn(p, n, choice, e, Some(draws.drawn[k]));
+                let through = emitters.sample_drawn(p, n, choice, e, Some(&draws.drawn[k]));
                 assert_eq!(through, emitters.sample(p, n, choice, e));
                 assert_eq!(through.map(|(s, _)| s.wi), alone.map(|s| s.wi));
                 sampled += usize::from(alone.is_some());

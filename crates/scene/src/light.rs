@@ -225,7 +225,7 @@ impl Light {
         p: Vec3,
         u: Vec2,
         quad_sampling: QuadSampling,
-        drawn: Option<Option<DirectionSample>>,
+        drawn: Option<&Option<DirectionSample>>,
     ) -> Option<EmitterSample> {
         let (s, radiance): (DirectionSample, Vec3) = match *self {
             Light::Sphere {
@@ -234,7 +234,7 @@ impl Light {
                 radiance,
             } => {
                 let s = match drawn {
-                    Some(s) => s?,
+                    Some(s) => (*s)?,
                     None => sample_sphere_light(p, center, radius, u)?,
                 };
                 // Only the outward face emits.
@@ -250,7 +250,7 @@ impl Light {
                 radiance,
             } => {
                 let s = match (drawn, quad_sampling) {
-                    (Some(s), _) => s?,
+                    (Some(s), _) => (*s)?,
                     (None, QuadSampling::SolidAngle) if is_rectangle(edge_u, edge_v) => {
                         // Falls back to area sampling where the spherical
                         // rectangle cannot be sampled accurately (its solid angle
@@ -440,7 +440,7 @@ mod tests {
                 for u in us {
                     let drawn = frame.sample(p, u);
                     let sample = light.sample(p, u, QuadSampling::SolidAngle);
-                    let through = light.sample_drawn(p, u, QuadSampling::SolidAngle, Some(drawn));
+                    let through = light.sample_drawn(p, u, QuadSampling::SolidAngle, Some(&drawn));
                     assert_eq!(sample, through, "{light:?} from {p} with {u}");
                     assert_eq!(drawn.map(|d| d.wi), sample.map(|s| s.wi));
                     let wi = drawn.map_or(Vec3::Y, |d| d.wi);
