@@ -275,19 +275,30 @@ impl RectangleDraws {
                     std::array::from_fn(|i| request(i).0),
                 )
             }));
+        // Whole groups of slots, each drawn into in place; the last group's spare lanes
+        // are cut off after.
         self.drawn.clear();
-        for (group, seen) in self.requests.chunks(RECTANGLE_LANES).zip(&self.seen) {
-            let drawn = seen.sample(std::array::from_fn(|i| group[i.min(group.len() - 1)].1));
+        self.drawn.resize(self.seen.len() * RECTANGLE_LANES, None);
+        let slots = self.drawn.as_chunks_mut::<RECTANGLE_LANES>().0;
+        for ((group, seen), slots) in self
+            .requests
+            .chunks(RECTANGLE_LANES)
+            .zip(&self.seen)
+            .zip(slots)
+        {
+            seen.sample_into(
+                std::array::from_fn(|i| group[i.min(group.len() - 1)].1),
+                slots,
+            );
             // The lanes whose light has no spherical rectangle from their point are
             // sampled by area, alone.
-            for (i, (&(p, u, light), drawn)) in group.iter().zip(drawn).enumerate() {
-                self.drawn.push(if seen.exists(i) {
-                    drawn
-                } else {
-                    frame(light).sample_seen(None, p, u)
-                });
+            for (i, (&(p, u, light), slot)) in group.iter().zip(slots).enumerate() {
+                if !seen.exists(i) {
+                    *slot = frame(light).sample_seen(None, p, u);
+                }
             }
         }
+        self.drawn.truncate(self.requests.len());
     }
 }
 

@@ -232,6 +232,21 @@ impl SphericalRectangles {
     /// Lanes without a rectangle give values to be ignored.
     #[inline]
     pub fn sample(&self, u: [Vec2; RECTANGLE_LANES]) -> [Option<DirectionSample>; RECTANGLE_LANES] {
+        let mut out = [None; RECTANGLE_LANES];
+        self.sample_into(u, &mut out);
+        out
+    }
+
+    /// [`SphericalRectangles::sample`] written into `out`, each lane's sample stored into
+    /// its slot as it is made: for a caller that keeps the samples in memory, since an
+    /// array of them returned whole is stored in pieces and copied out a vector at a
+    /// time, and each load waits for its stores to retire.
+    #[inline]
+    pub fn sample_into(
+        &self,
+        u: [Vec2; RECTANGLE_LANES],
+        out: &mut [Option<DirectionSample>; RECTANGLE_LANES],
+    ) {
         let (solid_angle, cos_k, sin_k) = (self.solid_angle, self.cos_k, self.sin_k);
         let (z0, x0, x1, y0, y1) = (self.z0, self.x0, self.x1, self.y0, self.y1);
         let u = u.map(clamp_u2);
@@ -267,7 +282,7 @@ impl SphericalRectangles {
         let wi = local * (f64x4::ONE / distance);
         let point = self.o + local;
         let (pdf, distance) = ((f64x4::ONE / solid_angle).to_array(), distance.to_array());
-        std::array::from_fn(|i| {
+        for (i, out) in out.iter_mut().enumerate() {
             let sample = DirectionSample {
                 wi: wi.lane(i).as_vec3(),
                 distance: distance[i] as f32,
@@ -281,8 +296,8 @@ impl SphericalRectangles {
                 && sample.distance > 0.0
                 && sample.pdf.is_finite()
                 && sample.pdf > 0.0;
-            ok.then_some(sample)
-        })
+            *out = ok.then_some(sample);
+        }
     }
 }
 
