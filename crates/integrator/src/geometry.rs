@@ -7,8 +7,8 @@ use glam::Vec3;
 use lueur_sdf_math::{
     Aabb, BoundingSphere, DistanceField, HalfSpace, Lane, LaneDistance, LaneKernel, LaneVec3,
     MAX_LANES, OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClipLanes, Sdf, SimdLevel,
-    StreamField, TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed_stream_of,
-    write_lane,
+    StreamField, TraceOutcome, TraceParams, fill_lane_groups, sphere_trace,
+    sphere_trace_relaxed_stream_of,
 };
 
 use lueur_scene::{Marching, Object};
@@ -119,6 +119,9 @@ pub(crate) struct MarchBatch {
     /// While clipping, per group of [`OBJECTS_PER_MASK`] positions in the order, the
     /// candidates of each lane among them: position `j` of the group as `2^j`, summed.
     kept: Vec<[f32; MAX_LANES]>,
+    /// While clipping, per group of queued rays a vector holds, their rays and parameters
+    /// as rows of lanes ([`CLIP_ROWS`]).
+    clip_rows: Vec<[[f32; MAX_LANES]; CLIP_ROWS]>,
     /// While marching, [`CandidateLanes`]'s `member` and `members`.
     member: Vec<[f32; MAX_LANES]>,
     members: Vec<u32>,
@@ -162,6 +165,10 @@ impl MarchBatch {
     }
 }
 
+/// Rows of a group of rays in [`MarchBatch::clip_rows`]: the origin, the direction, then
+/// the parameters `eps_abs`, `eps_rel`, `t_min`, `t_max`.
+const CLIP_ROWS: usize = 10;
+
 /// Objects per row of [`MarchBatch::kept`]: sums of distinct powers of two are exact in
 /// `f32` below `2^24`.
 const OBJECTS_PER_MASK: usize = 24;
@@ -185,28 +192,28 @@ impl LaneKernel for Clip<'_> {
             geometry.order.len().div_ceil(OBJECTS_PER_MASK),
             [0.0; MAX_LANES],
         );
+        // Every group's rows first, then each group's clip ([`fill_lane_groups`] says
+        // why). Lanes past a short last group are never read (`live`).
+        let mut rows = std::mem::take(&mut batch.clip_rows);
+        let records = batch.queued.iter().map(|(_, ray, p)| {
+            [
+                ray.origin.x,
+                ray.origin.y,
+                ray.origin.z,
+                ray.dir.x,
+                ray.dir.y,
+                ray.dir.z,
+                p.eps_abs,
+                p.eps_rel,
+                p.t_min,
+                p.t_max,
+            ]
+        });
+        fill_lane_groups(records, batch.queued.len(), lanes, &mut rows);
         let mut start = 0;
-        // Kept across groups: lanes past a short last group hold an earlier ray, finite
-        // and never read (`live`).
-        let mut v = [[0f32; MAX_LANES]; 10];
-        while start < batch.queued.len() {
+        for v in &rows {
             let group = start..(start + lanes).min(batch.queued.len());
             start = group.end;
-            for (lane, (_, ray, p)) in batch.queued[group.clone()].iter().enumerate() {
-                let values = [
-                    ray.origin.x,
-                    ray.origin.y,
-                    ray.origin.z,
-                    ray.dir.x,
-                    ray.dir.y,
-                    ray.dir.z,
-                    p.eps_abs,
-                    p.eps_rel,
-                    p.t_min,
-                    p.t_max,
-                ];
-                write_lane(&mut v, lane, values);
-            }
             let row = |i: usize| -> &[f32] { &v[i][..lanes] };
             let (t_min, t_max) = (L::load(row(8)), L::load(row(9)));
             let clip = RayClipLanes::from_lanes(
@@ -280,6 +287,7 @@ impl LaneKernel for Clip<'_> {
             }
         }
         batch.kept = kept_rows;
+        batch.clip_rows = rows;
     }
 }
 

@@ -9,7 +9,7 @@ use lueur_sampling::{
     SphericalRectangles, cosine_hemisphere_pdf, sample_cosine_hemisphere,
     sample_sphere_light_lanes,
 };
-use lueur_sdf_math::{Lane, LaneKernel, LaneVec3, MAX_LANES, SimdLevel, write_lane};
+use lueur_sdf_math::{Lane, LaneKernel, LaneVec3, MAX_LANES, SimdLevel, fill_lane_groups};
 
 use lueur_scene::{EmitterSample, Light, QuadSampling};
 
@@ -311,6 +311,8 @@ impl RectangleDraws {
 pub(crate) struct SphereDraws {
     /// Per request: the shading point, the sphere's centre and radius, `u`.
     requests: Vec<[f32; 9]>,
+    /// While drawing, the requests as rows of lanes, a group per vector.
+    rows: Vec<[[f32; MAX_LANES]; 9]>,
     /// Per request, after [`SphereDraws::draw`]: its sample.
     pub drawn: Vec<Option<DirectionSample>>,
 }
@@ -341,6 +343,7 @@ impl SphereDraws {
         // The level is available: `or_widest` says so.
         let _ = level.or_widest().dispatch(DrawSpheres {
             requests: &self.requests,
+            rows: &mut self.rows,
             drawn: &mut self.drawn,
         });
     }
@@ -349,6 +352,7 @@ impl SphereDraws {
 /// The kernel of [`SphereDraws::draw`].
 struct DrawSpheres<'a> {
     requests: &'a [[f32; 9]],
+    rows: &'a mut Vec<[[f32; MAX_LANES]; 9]>,
     drawn: &'a mut Vec<Option<DirectionSample>>,
 }
 
@@ -357,19 +361,22 @@ impl LaneKernel for DrawSpheres<'_> {
 
     #[inline(always)]
     fn run<L: Lane>(self) {
-        let DrawSpheres { requests, drawn } = self;
+        let DrawSpheres {
+            requests,
+            rows,
+            drawn,
+        } = self;
         let n = requests.len();
-        let mut start = 0;
         // Whole rows in and out, whatever the group's size: a load or store of a length
-        // not known when compiling is a call to `memcpy`. Lanes past a short last group
-        // hold an earlier request, finite, and are not read back.
+        // not known when compiling is a call to `memcpy`. Every group's rows are written
+        // first ([`fill_lane_groups`] says why); lanes past a short last group are not
+        // read back.
         let width = L::LANES.min(MAX_LANES);
-        let mut rows = [[0f32; MAX_LANES]; 9];
-        while start < n {
-            let end = (start + L::LANES).min(n);
-            fill_rows(&requests[start..end], &mut rows);
+        fill_lane_groups(requests.iter().copied(), n, width, rows);
+        for (g, rows) in rows.iter().enumerate() {
+            let (start, end) = (g * width, ((g + 1) * width).min(n));
             let mut lanes = [L::splat(0.0); 9];
-            for (lane, row) in lanes.iter_mut().zip(&rows) {
+            for (lane, row) in lanes.iter_mut().zip(rows) {
                 *lane = L::load(&row[..width]);
             }
             let [px, py, pz, cx, cy, cz, radius, u0, u1] = lanes;
@@ -393,17 +400,6 @@ impl LaneKernel for DrawSpheres<'_> {
                     normal: Vec3::new(out[8][lane], out[9][lane], out[10][lane]),
                 })
             }));
-            start = end;
         }
-    }
-}
-
-/// Puts request `i` of `group` in lane `i` of `rows`. Out of line, as
-/// `RelaxedStream::take` is: inlined, the optimiser forwards the scalar stores into the
-/// kernel's vector loads and builds each row from its lanes.
-#[inline(never)]
-fn fill_rows(group: &[[f32; 9]], rows: &mut [[f32; MAX_LANES]; 9]) {
-    for (lane, request) in group.iter().enumerate() {
-        write_lane(rows, lane, *request);
     }
 }

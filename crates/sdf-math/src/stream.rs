@@ -50,6 +50,32 @@ pub fn write_lane<const R: usize>(rows: &mut [[f32; MAX_LANES]; R], lane: usize,
     }
 }
 
+/// Rows of lanes for a kernel that takes its inputs a vector at a time: record `k` of
+/// `records` (`n` of them) in lane `k % width` of group `k / width` of `groups` (cleared
+/// first). Every group is written before the kernel loads the first: a vector loaded
+/// right after the scalar stores of its lanes waits for them to retire, where one loaded
+/// later is read from the cache. Lanes past a short last group hold the group before's
+/// records (zeros where there is none): finite, for the kernel to ignore.
+pub fn fill_lane_groups<const R: usize>(
+    records: impl IntoIterator<Item = [f32; R]>,
+    n: usize,
+    width: usize,
+    groups: &mut Vec<[[f32; MAX_LANES]; R]>,
+) {
+    assert!((1..=MAX_LANES).contains(&width), "{width} lanes");
+    groups.clear();
+    groups.resize(n.div_ceil(width), [[0.0; MAX_LANES]; R]);
+    for (k, values) in records.into_iter().take(n).enumerate() {
+        write_lane(&mut groups[k / width], k % width, values);
+    }
+    if let [.., before, last] = &mut groups[..] {
+        let filled = n - (n - 1) / width * width;
+        for (row, before) in last.iter_mut().zip(before.iter()) {
+            row[filled..width].copy_from_slice(&before[filled..width]);
+        }
+    }
+}
+
 /// One field for every ray of a stream.
 struct Shared<'a, F: ?Sized>(&'a F);
 
@@ -422,6 +448,35 @@ mod tests {
 
     use super::*;
     use crate::{OVER_RELAXATION, PreparedSdf, Sdf, sphere_trace, sphere_trace_relaxed};
+
+    /// Each record lands in its group and lane, for every count and width; a short last
+    /// group's spare lanes copy the group before's, and a buffer reused shrinks.
+    #[test]
+    fn lane_groups_hold_each_record_in_its_lane() {
+        let mut groups = Vec::new();
+        for width in [1, 4, 7, 8, 16] {
+            for n in [0, 1, width - 1, width, width + 1, 3 * width + 2] {
+                let records = (0..n).map(|k| [k as f32, -(k as f32)]);
+                fill_lane_groups(records, n, width, &mut groups);
+                assert_eq!(
+                    groups.len(),
+                    n.div_ceil(width),
+                    "{n} records, {width} lanes"
+                );
+                for k in 0..n {
+                    let (g, lane) = (k / width, k % width);
+                    assert_eq!(groups[g][0][lane], k as f32);
+                    assert_eq!(groups[g][1][lane], -(k as f32));
+                }
+                if n > width && n % width != 0 {
+                    let last = groups.len() - 1;
+                    for lane in n % width..width {
+                        assert_eq!(groups[last][0][lane], groups[last - 1][0][lane]);
+                    }
+                }
+            }
+        }
+    }
 
     /// An outcome as bits, so that equality is bitwise (`-0.0 != 0.0`, NaN == NaN).
     fn bits(o: &TraceOutcome) -> (u8, u32, u32) {
