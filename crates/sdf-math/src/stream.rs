@@ -65,8 +65,15 @@ pub fn fill_lane_groups<const R: usize>(
     assert!((1..=MAX_LANES).contains(&width), "{width} lanes");
     groups.clear();
     groups.resize(n.div_ceil(width), [[0.0; MAX_LANES]; R]);
-    for (k, values) in records.into_iter().take(n).enumerate() {
-        write_lane(&mut groups[k / width], k % width, values);
+    // Counted, not `k / width` and `k % width`: the width is known only at run time, so
+    // those would be two integer divisions a record.
+    let (mut group, mut lane) = (0, 0);
+    for values in records.into_iter().take(n) {
+        write_lane(&mut groups[group], lane, values);
+        lane += 1;
+        if lane == width {
+            (group, lane) = (group + 1, 0);
+        }
     }
     if let [.., before, last] = &mut groups[..] {
         let filled = n - (n - 1) / width * width;
@@ -469,10 +476,8 @@ mod tests {
                     assert_eq!(groups[g][1][lane], -(k as f32));
                 }
                 if n > width && n % width != 0 {
-                    let last = groups.len() - 1;
-                    for lane in n % width..width {
-                        assert_eq!(groups[last][0][lane], groups[last - 1][0][lane]);
-                    }
+                    let (last, spare) = (groups.len() - 1, n % width..width);
+                    assert_eq!(groups[last][0][spare.clone()], groups[last - 1][0][spare]);
                 }
             }
         }
