@@ -373,10 +373,10 @@ impl LaneKernel for DrawSpheres<'_> {
         // read back.
         let width = L::LANES.min(MAX_LANES);
         fill_lane_groups(requests.iter().copied(), n, width, rows);
-        for (g, rows) in rows.iter().enumerate() {
+        for (g, group) in rows.iter().enumerate() {
             let (start, end) = (g * width, ((g + 1) * width).min(n));
             let mut lanes = [L::splat(0.0); 9];
-            for (lane, row) in lanes.iter_mut().zip(rows) {
+            for (lane, row) in lanes.iter_mut().zip(group) {
                 *lane = L::load(&row[..width]);
             }
             let [px, py, pz, cx, cy, cz, radius, u0, u1] = lanes;

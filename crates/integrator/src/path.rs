@@ -430,6 +430,9 @@ pub(crate) fn radiance_wave(
             pending.cosine = (diffuse && strategy::scatters_by_cosine(settings.strategy))
                 .then(|| s.cosines.request(u.bsdf));
         }
+        // The shading below and the scattering after pair each vertex with its shading
+        // point by index.
+        debug_assert_eq!(s.pending.len(), s.surfaces.len());
         s.lights.draw(tracing.simd, &lighting.emitters);
         s.cosines.draw(tracing.simd);
 
