@@ -209,7 +209,7 @@ impl LaneKernel for Clip<'_> {
                 p.t_max,
             ]
         });
-        fill_lane_groups(records, batch.queued.len(), lanes, &mut rows);
+        fill_lane_groups(records, lanes, &mut rows);
         let mut start = 0;
         for v in &rows {
             let group = start..(start + lanes).min(batch.queued.len());

@@ -372,7 +372,7 @@ impl LaneKernel for DrawSpheres<'_> {
         // first ([`fill_lane_groups`] says why); lanes past a short last group are not
         // read back.
         let width = L::LANES.min(MAX_LANES);
-        fill_lane_groups(requests.iter().copied(), n, width, rows);
+        fill_lane_groups(requests.iter().copied(), width, rows);
         for (g, group) in rows.iter().enumerate() {
             let (start, end) = (g * width, ((g + 1) * width).min(n));
             let mut lanes = [L::splat(0.0); 9];

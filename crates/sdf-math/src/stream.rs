@@ -51,34 +51,32 @@ pub fn write_lane<const R: usize>(rows: &mut [[f32; MAX_LANES]; R], lane: usize,
 }
 
 /// Rows of lanes for a kernel that takes its inputs a vector at a time: record `k` of
-/// `records` (`n` of them) in lane `k % width` of group `k / width` of `groups` (cleared
-/// first). Every group is written before the kernel loads the first: a vector loaded
+/// `records` in lane `k % width` of group `k / width` of `groups` (cleared first). Every group is written before the kernel loads the first: a vector loaded
 /// right after the scalar stores of its lanes waits for them to retire, where one loaded
 /// later is read from the cache. Lanes past a short last group hold the group before's
 /// records (zeros where there is none): finite, for the kernel to ignore.
 pub fn fill_lane_groups<const R: usize>(
-    records: impl IntoIterator<Item = [f32; R]>,
-    n: usize,
+    records: impl ExactSizeIterator<Item = [f32; R]>,
     width: usize,
     groups: &mut Vec<[[f32; MAX_LANES]; R]>,
 ) {
     assert!((1..=MAX_LANES).contains(&width), "{width} lanes");
     groups.clear();
-    groups.resize(n.div_ceil(width), [[0.0; MAX_LANES]; R]);
+    groups.resize(records.len().div_ceil(width), [[0.0; MAX_LANES]; R]);
     // Counted, not `k / width` and `k % width`: the width is known only at run time, so
     // those would be two integer divisions a record.
     let (mut group, mut lane) = (0, 0);
-    for values in records.into_iter().take(n) {
+    for values in records {
         write_lane(&mut groups[group], lane, values);
         lane += 1;
         if lane == width {
             (group, lane) = (group + 1, 0);
         }
     }
-    if let [.., before, last] = &mut groups[..] {
-        let filled = n - (n - 1) / width * width;
+    // `lane` is now how many lanes the last group fills, 0 if all.
+    if let ([.., before, last], 1..) = (&mut groups[..], lane) {
         for (row, before) in last.iter_mut().zip(before.iter()) {
-            row[filled..width].copy_from_slice(&before[filled..width]);
+            row[lane..width].copy_from_slice(&before[lane..width]);
         }
     }
 }
@@ -464,7 +462,7 @@ mod tests {
         for width in [1, 4, 7, 8, 16] {
             for n in [0, 1, width - 1, width, width + 1, 3 * width + 2] {
                 let records = (0..n).map(|k| [k as f32, -(k as f32)]);
-                fill_lane_groups(records, n, width, &mut groups);
+                fill_lane_groups(records, width, &mut groups);
                 assert_eq!(
                     groups.len(),
                     n.div_ceil(width),
