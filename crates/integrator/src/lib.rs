@@ -64,10 +64,9 @@ mod trace;
 
 pub use film::{BlockSlots, Film, FilmError, PixelStats, SlotFill, dyadic_blocks, is_dyadic};
 pub use lueur_sdf_math::SimdLevel;
-pub use path::RayCounters;
 pub use render::{
     Pass, PixelBounds, RenderOutput, RenderStats, render, render_pass, render_pass_in,
 };
 pub use replicates::PixelEstimate;
 pub use scene::{Execution, PreparedScene};
-pub use trace::{Hit, STEP_BUCKETS, TraceCounters};
+pub use trace::{Hit, RayCounters, STEP_BUCKETS, TraceCounters};

@@ -4,6 +4,8 @@
 //! Each stage is a function of one path's inputs only, so a path's estimate
 //! does not depend on the paths beside it.
 
+use std::collections::VecDeque;
+
 use glam::Vec3;
 use lueur_materials::Material;
 use lueur_sampling::{DirectionSample, Sampler};
@@ -13,41 +15,11 @@ use lueur_sdf_math::TraceParams;
 
 use crate::strategy::{self, CosineDraws, EmissionWeight, Lighting, Scatter, Vertex, VertexSample};
 use crate::surface::{March, SurfaceHit, SurfacePoint, SurfaceScratch};
-use crate::trace::{PathRay, ShadowRay, TraceScratch, Tracing};
+use crate::trace::{PathRay, RayCounters, ShadowRay, TraceScratch, Tracing};
 use lueur_scene::RenderSettings;
 
 use crate::light_sampler::{Emitters, RectangleDraws, SphereDraws};
-use crate::{Hit, PreparedScene, TraceCounters};
-
-/// Counters per kind of ray.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct RayCounters {
-    /// Rays from the camera.
-    pub camera: TraceCounters,
-    /// Rays continuing a path after a scattering event.
-    pub bounce: TraceCounters,
-    /// Shadow rays of next-event estimation.
-    pub shadow: TraceCounters,
-}
-
-impl RayCounters {
-    /// Adds another set of counters.
-    pub fn merge(&mut self, o: &RayCounters) {
-        self.camera.merge(&o.camera);
-        self.bounce.merge(&o.bounce);
-        self.shadow.merge(&o.shadow);
-    }
-
-    /// The counters of the ray that leaves vertex `depth` of a path (the
-    /// camera's at 0).
-    fn path_ray(&mut self, depth: u32) -> &mut TraceCounters {
-        if depth == 0 {
-            &mut self.camera
-        } else {
-            &mut self.bounce
-        }
-    }
-}
+use crate::{Hit, PreparedScene};
 
 /// State carried from one vertex to the next for weighting emission.
 #[derive(Clone, Copy)]
@@ -67,7 +39,7 @@ struct Previous {
 impl Previous {
     /// The camera, as the vertex before the first: what its rays find counts
     /// in full.
-    fn camera(position: Vec3) -> Previous {
+    const fn camera(position: Vec3) -> Previous {
         Previous {
             p: position,
             n: Vec3::ZERO,
@@ -92,9 +64,14 @@ pub(crate) struct SampleId {
     pub index: u32,
 }
 
-/// One path in flight: the ray it traces next and what it has gathered.
+/// One path in flight: the sample it estimates, the ray it traces next and what it has
+/// gathered.
 #[derive(Clone, Copy)]
 struct Path {
+    id: SampleId,
+    /// The order in which the wave started it, which is the order its estimate is handed
+    /// on in.
+    ordinal: u64,
     ray: Ray,
     params: TraceParams,
     beta: Vec3,
@@ -102,6 +79,23 @@ struct Path {
     previous: Previous,
     /// Scattering events so far.
     depth: u32,
+}
+
+impl Path {
+    /// A path before its sample, camera ray and parameters are written in.
+    const START: Path = Path {
+        id: SampleId {
+            pixel: [0, 0],
+            index: 0,
+        },
+        ordinal: 0,
+        ray: PathRay::UNSET.ray,
+        params: PathRay::UNSET.params,
+        beta: Vec3::ONE,
+        radiance: Vec3::ZERO,
+        previous: Previous::camera(Vec3::ZERO),
+        depth: 0,
+    };
 }
 
 /// A path shaded at a vertex, waiting for its shadow rays: the vertex, the shadow rays'
@@ -182,7 +176,17 @@ impl LightDraws {
 /// A thread's buffers for [`radiance_wave`], kept from one wave to the next.
 #[derive(Default)]
 pub(crate) struct WaveScratch {
+    /// The wave's slots: each path in flight, and each path's own copy of the sampler.
     paths: Vec<Path>,
+    samplers: Vec<Sampler>,
+    /// The slots whose path has ended, free for the next sample.
+    vacant: Vec<usize>,
+    /// Estimates from the oldest path in flight on, in the order their paths started, as
+    /// they end; handed on from the front as it fills.
+    ended: VecDeque<Option<(SampleId, Vec3)>>,
+    /// The ordinal of `ended`'s front.
+    ended_from: u64,
+    /// The slots of the paths in flight.
     active: Vec<usize>,
     rays: Vec<PathRay>,
     hits: Vec<Option<Hit>>,
@@ -288,25 +292,34 @@ fn shade(
     out.shadow = (first, shadow.rays.len());
 }
 
-/// Radiance arriving along each of `camera_rays` (sample `ids[i]` for ray `i`, its numbers
-/// drawn from `samplers[i]`), estimated by one path each, into `out` (cleared first).
+/// How many estimates, per path in flight, may wait for an older path to end before the
+/// wave stops starting paths: bounds a wave's memory when `max_depth` is large, and is
+/// not reached otherwise (a path ends within `max_depth + 1` vertices, and each vertex
+/// starts at most a wave's worth).
+const ENDED_PER_SLOT: usize = 16;
+
+/// The radiance of the pixel samples `next` gives (each as its id, camera ray and a copy
+/// of the sampler positioned past the camera's dimensions), estimated by one path each,
+/// handed to `estimate` in the order `next` gave them.
 ///
-/// The paths advance together, a vertex at a time: their rays are traced as one stream,
-/// then each draws its vertex's numbers, the sphere-light samples its next-event
-/// estimation chose are drawn as one batch, then each is shaded, then their shadow rays
+/// Up to `width` paths advance together, a vertex at a time: their rays are traced as one
+/// stream, then each draws its vertex's numbers, the light samples and cosine directions
+/// the vertices chose are drawn as batches, then each is shaded, then their shadow rays
 /// are traced as another stream, then each gathers what its shadow rays bring and
-/// scatters. Every path does exactly what it
-/// would do alone (the stages are functions of the path's own inputs, and each path adds
-/// to its estimate in the same order), so an estimate does not depend on which paths
-/// share its wave, nor on the instruction set the streams run on.
+/// scatters. A path that ends hands its slot to the next sample at once, so the streams
+/// stay a wave wide, paths at every depth together, until `next` runs dry, rather than
+/// thinning to the few paths that live longest (docs/PERFORMANCE.md, "Waves that stay
+/// full"). Every path does exactly what it would do alone (the stages are functions of
+/// the path's own inputs, and each path adds to its estimate in the same order), so an
+/// estimate does not depend on which paths share its wave, nor on the instruction set
+/// the streams run on.
 pub(crate) fn radiance_wave(
     estimator: &Estimator<'_>,
-    camera_rays: &[Ray],
-    ids: &[SampleId],
-    samplers: &mut [Sampler],
+    width: usize,
+    next: &mut impl FnMut() -> Option<(SampleId, Ray, Sampler)>,
     counters: &mut RayCounters,
     scratch: &mut WaveScratch,
-    out: &mut Vec<Vec3>,
+    estimate: &mut impl FnMut(SampleId, Vec3),
 ) {
     let Estimator {
         scene,
@@ -314,31 +327,61 @@ pub(crate) fn radiance_wave(
         march,
         tracing,
     } = *estimator;
+    let width = width.max(1);
     let lighting = Lighting::of(scene, settings, &march);
     let s = scratch;
-    // Every path starts as the camera's, then takes its ray field by field: a `Path` made
-    // whole per ray is written in pieces on the stack and loaded back whole
-    // (docs/PERFORMANCE.md, "Stores loaded whole").
-    let start = Path {
-        ray: Ray {
-            origin: Vec3::ZERO,
-            dir: Vec3::Z,
-        },
-        params: march.camera,
-        beta: Vec3::ONE,
-        radiance: Vec3::ZERO,
-        previous: Previous::camera(Vec3::ZERO),
-        depth: 0,
-    };
     s.paths.clear();
-    s.paths.resize(camera_rays.len(), start);
-    for (path, ray) in s.paths.iter_mut().zip(camera_rays) {
-        path.ray = *ray;
-        path.previous.p = ray.origin;
-    }
+    s.samplers.clear();
+    s.vacant.clear();
+    s.ended.clear();
+    s.ended_from = 0;
     s.active.clear();
-    s.active.extend(0..s.paths.len());
-    while !s.active.is_empty() {
+    let mut started = 0u64;
+    let mut dry = false;
+    loop {
+        // Hand on the estimates that are next in order.
+        while let Some(Some(_)) = s.ended.front() {
+            let (id, l) = s.ended.pop_front().flatten().expect("an ended path");
+            estimate(id, l);
+            s.ended_from += 1;
+        }
+        // Start a path in every vacant slot.
+        while !dry
+            && (!s.vacant.is_empty() || s.paths.len() < width)
+            && s.ended.len() < ENDED_PER_SLOT * width
+        {
+            let Some((id, ray, sampler)) = next() else {
+                dry = true;
+                break;
+            };
+            let slot = match s.vacant.pop() {
+                Some(slot) => {
+                    s.samplers[slot] = sampler;
+                    slot
+                }
+                None => {
+                    s.paths.push(Path::START);
+                    s.samplers.push(sampler);
+                    s.paths.len() - 1
+                }
+            };
+            // Field by field into place: a `Path` made whole per ray is written in pieces
+            // on the stack and loaded back whole (docs/PERFORMANCE.md, "Stores loaded
+            // whole").
+            let path = &mut s.paths[slot];
+            *path = Path::START;
+            path.id = id;
+            path.ordinal = started;
+            path.ray = ray;
+            path.previous.p = ray.origin;
+            path.params = march.camera;
+            s.ended.push_back(None);
+            s.active.push(slot);
+            started += 1;
+        }
+        if s.active.is_empty() {
+            break;
+        }
         // Field by field into place: a `PathRay` made whole first is written in pieces on
         // the stack and loaded back whole, and every ray waits for its stores
         // (docs/PERFORMANCE.md, "Stores loaded whole").
@@ -349,11 +392,9 @@ pub(crate) fn radiance_wave(
             ray.from = path.previous.p;
             ray.params = path.params;
             ray.maybe_inside = path.depth == 0 && march.camera_inside || path.previous.in_solid;
+            ray.camera = path.depth == 0;
         }
-        // Every path in flight has scattered as often as the others.
-        let depth = s.paths[s.active[0]].depth;
-        let kind = counters.path_ray(depth);
-        scene.intersect_rays(&s.rays, tracing, kind, &mut s.trace, &mut s.hits);
+        scene.intersect_rays(&s.rays, tracing, counters, &mut s.trace, &mut s.hits);
 
         // The shading points of the hits that scatter, as one stream.
         s.surface_hits.clear();
@@ -383,9 +424,11 @@ pub(crate) fn radiance_wave(
             let Some(on_surface) = SurfaceHit::of(hit) else {
                 path.radiance +=
                     emission_found(&lighting, &path.previous, &path.ray, hit, path.beta);
+                end(path, i, &mut s.ended, s.ended_from, &mut s.vacant);
                 continue;
             };
             if path.depth >= settings.max_depth {
+                end(path, i, &mut s.ended, s.ended_from, &mut s.vacant);
                 continue;
             }
             let surface = surfaces
@@ -403,9 +446,9 @@ pub(crate) fn radiance_wave(
             });
             let pending = s.pending.last_mut().expect("pushed");
             pending.u.draw(
-                &mut samplers[i],
-                ids[i].pixel,
-                ids[i].index,
+                &mut s.samplers[i],
+                path.id.pixel,
+                path.id.index,
                 path.depth,
                 settings.strategy,
             );
@@ -461,17 +504,32 @@ pub(crate) fn radiance_wave(
 
         s.active.clear();
         for (shaded, surface) in s.shaded.iter().zip(&s.surfaces) {
-            let path = &mut s.paths[shaded.path];
+            let slot = shaded.path;
+            let path = &mut s.paths[slot];
             if shaded.diffuse {
                 gather(path, shaded, &s.shadow.contributions, &s.free, settings);
             }
             if scatter(path, (shaded, surface), &march, settings) {
-                s.active.push(shaded.path);
+                s.active.push(slot);
+            } else {
+                end(path, slot, &mut s.ended, s.ended_from, &mut s.vacant);
             }
         }
     }
-    out.clear();
-    out.extend(s.paths.iter().map(|p| p.radiance));
+    debug_assert!(s.ended.is_empty(), "every estimate handed on");
+}
+
+/// Ends the path in slot `slot`: its estimate waits in `ended` (whose front is path
+/// `ended_from`) for the paths started before it, and the slot is vacant.
+fn end(
+    path: &Path,
+    slot: usize,
+    ended: &mut VecDeque<Option<(SampleId, Vec3)>>,
+    ended_from: u64,
+    vacant: &mut Vec<usize>,
+) {
+    ended[(path.ordinal - ended_from) as usize] = Some((path.id, path.radiance));
+    vacant.push(slot);
 }
 
 /// Adds to the path's estimate what its shadow rays bring: the delta lights' sum, then

@@ -5,13 +5,14 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use glam::{UVec2, Vec3};
+use glam::UVec2;
 use lueur_sampling::Sampler;
-use lueur_sdf_math::{Ray, SimdLevel};
+use lueur_sdf_math::SimdLevel;
 use rayon::prelude::*;
 
+use crate::RayCounters;
 use crate::film::{Film, PixelStats};
-use crate::path::{Estimator, RayCounters, SampleId, WaveScratch, radiance_wave};
+use crate::path::{Estimator, SampleId, WaveScratch, radiance_wave};
 use crate::replicates::BlockCounter;
 use crate::strategy::CAMERA_DIMS;
 use crate::surface::March;
@@ -344,15 +345,10 @@ impl TileSink {
     }
 }
 
-/// A thread's buffers for rendering a tile: the wave's samples and everything its paths
-/// are traced and shaded with. Cleared before use, so what they held never reaches an
-/// image.
+/// A thread's buffers for rendering a tile: everything its wave's paths are traced and
+/// shaded with. Cleared before use, so what they held never reaches an image.
 #[derive(Default)]
 struct TileScratch {
-    ids: Vec<SampleId>,
-    rays: Vec<Ray>,
-    samplers: Vec<Sampler>,
-    estimates: Vec<Vec3>,
     wave: WaveScratch,
 }
 
@@ -410,49 +406,35 @@ fn render_tile(
     };
     let mut counters = RayCounters::default();
     let wave = estimator.scene.execution().wave.max(1);
-    let TileScratch {
-        ids,
-        rays,
-        samplers,
-        estimates,
-        wave: scratch,
-    } = scratch;
     let camera = &estimator.scene.scene().camera;
     let pixels =
         (origin.y..origin.y + th).flat_map(|y| (origin.x..origin.x + tw).map(move |x| [x, y]));
-    let mut pixel_samples = pixels
-        .flat_map(|pixel| samples.clone().map(move |index| SampleId { pixel, index }))
-        .peekable();
-    while pixel_samples.peek().is_some() {
-        if cancel.load(Ordering::Relaxed) {
-            return None;
-        }
-        ids.clear();
-        rays.clear();
-        samplers.clear();
-        for id in pixel_samples.by_ref().take(wave) {
-            sampler.start_pixel_sample(id.pixel, id.index, 0);
-            let jitter = sampler.next_2d();
-            // Each path keeps its own copy of the sampler, positioned past its camera
-            // dimensions, so that its vertices are reached from where it stands.
-            samplers.push(sampler.clone());
-            debug_assert_eq!(CAMERA_DIMS, 2);
-            let film_point = glam::Vec2::new(id.pixel[0] as f32, id.pixel[1] as f32) + jitter;
-            rays.push(camera.generate_ray(film_point, w, h));
-            ids.push(id);
-        }
-        radiance_wave(
-            estimator,
-            rays,
-            ids,
-            samplers,
-            &mut counters,
-            scratch,
-            estimates,
-        );
-        for (id, &l) in ids.iter().zip(&*estimates) {
-            tile.push(*id, l);
-        }
+    let mut pixel_samples =
+        pixels.flat_map(|pixel| samples.clone().map(move |index| SampleId { pixel, index }));
+    let mut cancelled = false;
+    // Polled at each path's start: a cancelled tile stops starting paths, and the paths in
+    // flight end within `max_depth + 1` vertices.
+    let mut next = || {
+        cancelled = cancelled || cancel.load(Ordering::Relaxed);
+        let id = pixel_samples.next().filter(|_| !cancelled)?;
+        sampler.start_pixel_sample(id.pixel, id.index, 0);
+        let jitter = sampler.next_2d();
+        debug_assert_eq!(CAMERA_DIMS, 2);
+        let film_point = glam::Vec2::new(id.pixel[0] as f32, id.pixel[1] as f32) + jitter;
+        // Each path keeps its own copy of the sampler, positioned past its camera
+        // dimensions, so that its vertices are reached from where it stands.
+        Some((id, camera.generate_ray(film_point, w, h), sampler.clone()))
+    };
+    radiance_wave(
+        estimator,
+        wave,
+        &mut next,
+        &mut counters,
+        &mut scratch.wave,
+        &mut |id, l| tile.push(id, l),
+    );
+    if cancelled {
+        return None;
     }
     tile.end_pixel();
     debug_assert!(

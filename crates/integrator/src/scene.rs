@@ -32,8 +32,9 @@ pub struct Execution {
     /// it has ([`SimdLevel::detect`]). By default the widest of at most
     /// [`Execution::LANES`] lanes.
     pub simd: SimdLevel,
-    /// Paths per wave (at least 1): enough to keep a vector's lanes busy while paths
-    /// end, few enough that a wave's rays stay in cache.
+    /// Paths a wave keeps in flight (at least 1): enough to fill a vector's lanes many
+    /// times over, few enough that a wave's rays stay in cache. A path that ends hands its
+    /// slot to the next sample, so the streams stay this wide until a tile runs dry.
     pub wave: usize,
 }
 

@@ -85,6 +85,11 @@ impl TraceCounters {
         self.tracing_nanos as f64 * 1e-9
     }
 
+    /// Rays and steps: what the time of a stream is shared by.
+    fn work(&self) -> u64 {
+        self.rays + self.steps
+    }
+
     /// Adds the time of a stream that started at `start`.
     fn timed(&mut self, start: Instant) {
         self.tracing_nanos += start.elapsed().as_nanos() as u64;
@@ -104,6 +109,52 @@ impl TraceCounters {
     }
 }
 
+/// Counters per kind of ray.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounters {
+    /// Rays from the camera.
+    pub camera: TraceCounters,
+    /// Rays continuing a path after a scattering event.
+    pub bounce: TraceCounters,
+    /// Shadow rays of next-event estimation.
+    pub shadow: TraceCounters,
+}
+
+impl RayCounters {
+    /// Adds another set of counters.
+    pub fn merge(&mut self, o: &RayCounters) {
+        self.camera.merge(&o.camera);
+        self.bounce.merge(&o.bounce);
+        self.shadow.merge(&o.shadow);
+    }
+
+    /// The counters of a path's ray: the camera's, or a bounce's.
+    fn path_ray(&mut self, camera: bool) -> &mut TraceCounters {
+        if camera {
+            &mut self.camera
+        } else {
+            &mut self.bounce
+        }
+    }
+
+    /// Adds the time of a stream of path rays that started at `start` to the camera's
+    /// and the bounces' counters, shared by the work each kind did in it (rays and
+    /// steps, from `before`, the two kinds' work when it started): one stream holds both
+    /// kinds, and the clock is read once per stream.
+    fn timed_paths(&mut self, start: Instant, before: [u64; 2]) {
+        let nanos = start.elapsed().as_nanos() as u64;
+        let camera = self.camera.work() - before[0];
+        let bounce = self.bounce.work() - before[1];
+        let to_camera = if camera + bounce == 0 {
+            nanos
+        } else {
+            (nanos as u128 * camera as u128 / (camera + bounce) as u128) as u64
+        };
+        self.camera.tracing_nanos += to_camera;
+        self.bounce.tracing_nanos += nanos - to_camera;
+    }
+}
+
 /// A ray a path traces to its next vertex.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PathRay {
@@ -115,6 +166,8 @@ pub(crate) struct PathRay {
     pub params: TraceParams,
     /// Whether the ray may start inside a solid ([`PreparedScene::intersect_maybe_inside`]).
     pub maybe_inside: bool,
+    /// Whether the ray leaves the camera, for the counters.
+    pub camera: bool,
 }
 
 impl PathRay {
@@ -133,6 +186,7 @@ impl PathRay {
             eps_rel: 0.0,
         },
         maybe_inside: false,
+        camera: false,
     };
 }
 
@@ -205,6 +259,7 @@ impl PreparedScene {
             from: ray.origin,
             params: *params,
             maybe_inside,
+            camera: true,
         };
         let tracing = Tracing {
             marching,
@@ -212,7 +267,9 @@ impl PreparedScene {
         };
         let mut hits = Vec::with_capacity(1);
         let scratch = &mut TraceScratch::default();
-        self.intersect_rays(&[path_ray], tracing, counters, scratch, &mut hits);
+        let mut kinds = RayCounters::default();
+        self.intersect_rays(&[path_ray], tracing, &mut kinds, scratch, &mut hits);
+        counters.merge(&kinds.camera);
         hits[0]
     }
 
@@ -228,11 +285,12 @@ impl PreparedScene {
         &self,
         rays: &[PathRay],
         tracing: Tracing,
-        counters: &mut TraceCounters,
+        counters: &mut RayCounters,
         scratch: &mut TraceScratch,
         hits: &mut Vec<Option<Hit>>,
     ) {
         let clock = Instant::now();
+        let before = [counters.camera.work(), counters.bounce.work()];
         hits.clear();
         scratch.batch.clear();
         scratch.marched.clear();
@@ -255,7 +313,7 @@ impl PreparedScene {
                     < -p.eps_abs.max(p.eps_rel * p.t_min);
             scratch.marched.push((p, inside));
             if !has_objects {
-                counters.rays += 1;
+                counters.path_ray(r.camera).rays += 1;
                 continue;
             }
             // The rare paths take a copy by reference, so that `p` itself stays in
@@ -273,7 +331,7 @@ impl PreparedScene {
                 None
             };
             if let Some((outcome, object)) = done {
-                counters.record(&outcome);
+                counters.path_ray(r.camera).record(&outcome);
                 let (p, inside) = scratch.marched[i];
                 hits[i] = self
                     .surface_hit(&r.ray, &p, inside, outcome, object)
@@ -282,13 +340,13 @@ impl PreparedScene {
         }
         self.geometry.march(tracing.simd, &mut scratch.batch);
         for (i, outcome, object) in scratch.batch.results() {
-            counters.record(&outcome);
+            counters.path_ray(rays[i].camera).record(&outcome);
             let (p, inside) = scratch.marched[i];
             hits[i] = self
                 .surface_hit(&rays[i].ray, &p, inside, outcome, object)
                 .or(hits[i]);
         }
-        counters.timed(clock);
+        counters.timed_paths(clock, before);
     }
 
     /// The surface a march of `ray` with parameters `params` found, if any. Inlined: its
