@@ -151,8 +151,9 @@ struct RenderArgs {
     /// it; for measuring and testing.
     #[arg(long, value_name = "LEVEL")]
     simd: Option<String>,
-    /// Paths advanced together, whose rays are traced as one stream (default
-    /// 256). The image does not depend on it; for measuring and testing.
+    /// Paths in flight together, whose rays are traced as one stream; a path
+    /// that ends gives its place to the next sample (default 256). The image
+    /// does not depend on it; for measuring and testing.
     #[arg(long, value_name = "PATHS")]
     wave: Option<usize>,
     /// Stop at this wall-clock budget in seconds: passes of 1, 1, 2, 4, ...

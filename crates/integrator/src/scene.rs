@@ -25,7 +25,7 @@ pub struct PreparedScene {
 }
 
 /// How renders of a scene run on this machine, which never changes an image: the
-/// instruction set the ray streams run on, and how many paths advance together.
+/// instruction set the ray streams run on, and how many paths are in flight together.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Execution {
     /// The vectors of fast marching's streams; a level this CPU lacks runs on the widest
