@@ -336,7 +336,6 @@ pub(crate) fn radiance_wave(
     s.ended.clear();
     s.ended_from = 0;
     s.active.clear();
-    let mut started = 0u64;
     let mut dry = false;
     loop {
         // Hand on the estimates that are next in order.
@@ -371,13 +370,13 @@ pub(crate) fn radiance_wave(
             let path = &mut s.paths[slot];
             *path = Path::START;
             path.id = id;
-            path.ordinal = started;
+            // The paths started so far: those handed on, and those waiting.
+            path.ordinal = s.ended_from + s.ended.len() as u64;
             path.ray = ray;
             path.previous.p = ray.origin;
             path.params = march.camera;
             s.ended.push_back(None);
             s.active.push(slot);
-            started += 1;
         }
         if s.active.is_empty() {
             break;
