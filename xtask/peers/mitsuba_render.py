@@ -14,9 +14,14 @@ within noise):
 - lueur's pixel filter is the box of the pixel (uniform jitter): `box`.
 - The camera: `look_at` with the same up vector and a vertical `fov`
   frames the same image, with the same orientation.
+- Russian roulette: `--rr-depth` is lueur's `roulette_depth`, the
+  scattering events before roulette may end a path. Both then keep a path
+  with the probability of its throughput's largest component; Mitsuba also
+  ends at least 1 in 20 paths (its survival is capped at 0.95), where lueur
+  keeps every path whose throughput has a component of 1 or more.
 
-Usage: mitsuba_render.py SCENE.toml VARIANT SPP OUT.exr [--seed S]
-       [--sampler independent|multijitter|ldsampler|orthogonal]
+Usage: mitsuba_render.py SCENE.toml VARIANT SPP OUT.exr --rr-depth N
+       [--seed S] [--sampler independent|multijitter|ldsampler|orthogonal]
        [--repeats N] [--passes N] [--width W --height H] [--max-depth D]
 
 --repeats N renders N more times after the first (timing: the first render
@@ -129,9 +134,12 @@ def main():
     p.add_argument("--width", type=int)
     p.add_argument("--height", type=int)
     p.add_argument("--max-depth", type=int)
-    # Mitsuba's default is 5; 4 starts roulette after about as many
-    # bounces as lueur's default roulette_depth 3. A large value turns it off.
-    p.add_argument("--rr-depth", type=int, default=4)
+    # lueur's roulette_depth for the scene, which the xtask passes: both
+    # renderers count scattering events before roulette may end a path
+    # (Mitsuba's `depth >= rr_depth` after a vertex's increment, lueur's
+    # `depth >= roulette_depth` after a scatter's), so the same number runs
+    # the same estimator. A large value turns roulette off.
+    p.add_argument("--rr-depth", type=int, required=True)
     args = p.parse_args()
 
     import drjit as dr

@@ -157,10 +157,16 @@ fn scene_path() -> PathBuf {
 /// Runs the Mitsuba script on [`SCENE`]; returns the numbers it prints,
 /// one `key value` line each.
 pub fn mitsuba(args: &[String]) -> Result<HashMap<String, f64>> {
+    // Mitsuba's `rr_depth` and lueur's `roulette_depth` both count scattering events
+    // before roulette may end a path: the same number runs the same estimator. One
+    // bounce more of full survival costs Mitsuba about a tenth more time and saves it
+    // about a sixth of its MSE (docs/PERFORMANCE.md, "Where the MSE gap is").
+    let roulette_depth = load_scene(SCENE)?.settings.roulette_depth;
     let out = python()
         .arg(script())
         .arg(scene_path())
         .args(args)
+        .args(["--rr-depth".to_owned(), roulette_depth.to_string()])
         .output()
         .context("cannot run python3")?;
     if !out.status.success() {
@@ -503,9 +509,12 @@ fn report(
          Lambertian and mirror materials, a sphere light. Mitsuba {} runs \
          `xtask/peers/mitsuba_render.py`, which translates the scene file (its `path` \
          integrator combines BSDF and emitter sampling by the power heuristic, as lueur's \
-         `mis` does). Both on this machine's 2 cores, in one run. Mitsuba is a peer for this \
-         report, never a dependency: the report refuses to run without it.\n",
-        mitsuba_version()
+         `mis` does), with roulette from the same depth as lueur's (`rr_depth` = \
+         `roulette_depth` = {}, scattering events). Both on this machine's 2 cores, in one \
+         run. Mitsuba is a peer for this report, never a dependency: the report refuses to \
+         run without it.\n",
+        mitsuba_version(),
+        load_scene(SCENE)?.settings.roulette_depth,
     )?;
     writeln!(md, "## Correctness\n")?;
     writeln!(
