@@ -146,13 +146,12 @@ struct RenderArgs {
     #[arg(long)]
     naive: bool,
     /// The instruction set the ray streams run on: scalar, portable, sse, avx2,
-    /// avx512 or neon (default: the widest this CPU has of at most 8 lanes, so AVX2
-    /// on an AVX-512 CPU, which was measured faster). The image does not depend on
-    /// it; for measuring and testing.
+    /// avx512 or neon (default: the widest this CPU has). The image does not depend
+    /// on it; for measuring and testing.
     #[arg(long, value_name = "LEVEL")]
     simd: Option<String>,
     /// Paths in flight together, whose rays are traced as one stream; a path
-    /// that ends gives its place to the next sample (default 256). The image
+    /// that ends gives its place to the next sample (default 512). The image
     /// does not depend on it; for measuring and testing.
     #[arg(long, value_name = "PATHS")]
     wave: Option<usize>,

@@ -29,8 +29,9 @@ pub struct PreparedScene {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Execution {
     /// The vectors of fast marching's streams; a level this CPU lacks runs on the widest
-    /// it has ([`SimdLevel::detect`]). By default the widest of at most
-    /// [`Execution::LANES`] lanes.
+    /// it has ([`SimdLevel::detect`]). By default the widest it has: AVX-512's 16 lanes
+    /// ran the shipped scenes 1.09-1.15x as fast as AVX2's 8 on the Intel Xeon measured
+    /// (docs/PERFORMANCE.md, "Sixteen lanes with bit masks").
     pub simd: SimdLevel,
     /// Paths a wave keeps in flight (at least 1): enough to fill a vector's lanes many
     /// times over, few enough that a wave's rays stay in cache. A path that ends hands its
@@ -39,23 +40,16 @@ pub struct Execution {
 }
 
 impl Execution {
-    /// Paths per wave by default: 32 vectors of 8 lanes, measured against 16 to 4096
-    /// paths in docs/PERFORMANCE.md.
-    pub const WAVE: usize = 256;
-
-    /// The widest vectors the renderer uses by default: on the one AVX-512 machine
-    /// measured (a 2-core AMD EPYC, whose cores run a 16-lane instruction as two halves),
-    /// AVX2's 8 lanes rendered the shipped scenes 1.10-1.19x as fast as AVX-512's 16, whose
-    /// kernels took a quarter more time; a wider wave did not close the gap
-    /// (docs/PERFORMANCE.md, "Eight lanes or sixteen"). `--simd avx512` still runs them,
-    /// to the same bits.
-    pub const LANES: usize = 8;
+    /// Paths per wave by default: 32 vectors of 16 lanes, measured against 16 to 4096
+    /// paths in docs/PERFORMANCE.md (on 16 lanes, 512 ran 1-5% faster than 256 and as
+    /// fast as 1024).
+    pub const WAVE: usize = 512;
 }
 
 impl Default for Execution {
     fn default() -> Execution {
         Execution {
-            simd: SimdLevel::widest_up_to(Execution::LANES),
+            simd: SimdLevel::detect(),
             wave: Execution::WAVE,
         }
     }

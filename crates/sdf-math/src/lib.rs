@@ -66,8 +66,8 @@ pub use crate::blend::{smooth_max, smooth_min};
 pub use crate::bound::{Aabb, BoundingSphere, HalfSpace, RayClip, RayClipLanes};
 pub use crate::field::DistanceField;
 pub use crate::lanes::{
-    Avx2, Avx512, BitMask, BoolMask, Isa, Lane, LaneDistance, LaneKernel, LaneMask, LaneVec3, Mask,
-    MaskLane, Neon, Portable, SimdLevel, Sse, Task, UnavailableLevel, Wide,
+    Avx2, Avx512, BitMask, Isa, Lane, LaneDistance, LaneKernel, LaneMask, LaneVec3, Mask, MaskLane,
+    Neon, Portable, SimdLevel, Sse, Task, UnavailableLevel, Wide,
 };
 pub use crate::normal::{
     FALLBACK_NORMAL, Tetrahedron, gradient, gradient_central, gradient_lanes, normal,

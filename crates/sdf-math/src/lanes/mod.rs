@@ -18,9 +18,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 pub use dispatch::{LaneDistance, LaneKernel, SimdLevel, UnavailableLevel};
 pub(crate) use vec::LaneVec2;
 pub use vec::LaneVec3;
-pub use wide::{
-    Avx2, Avx512, BitMask, BoolMask, Isa, LaneMask, Mask, MaskLane, Neon, Portable, Sse, Wide,
-};
+pub use wide::{Avx2, Avx512, BitMask, Isa, LaneMask, Mask, MaskLane, Neon, Portable, Sse, Wide};
 
 /// A number type with `LANES` independent `f32` lanes: `f32` itself, or a [`Wide`] vector.
 ///
