@@ -17,8 +17,9 @@ within noise):
 - Russian roulette: `--rr-depth` is lueur's `roulette_depth`, the
   scattering events before roulette may end a path. Both then keep a path
   with the probability of its throughput's largest component; Mitsuba also
-  ends at least 1 in 20 paths (its survival is capped at 0.95), where lueur
-  keeps every path whose throughput has a component of 1 or more.
+  ends at least 1 path in 20 at each bounce past that depth (its survival
+  is capped at 0.95), where lueur keeps every path whose throughput has a
+  component of 1 or more.
 
 Usage: mitsuba_render.py SCENE.toml VARIANT SPP OUT.exr --rr-depth N
        [--seed S] [--sampler independent|multijitter|ldsampler|orthogonal]

@@ -159,8 +159,8 @@ fn scene_path() -> PathBuf {
 pub fn mitsuba(args: &[String]) -> Result<HashMap<String, f64>> {
     // Mitsuba's `rr_depth` and lueur's `roulette_depth` both count scattering events
     // before roulette may end a path: the same number runs the same estimator. One
-    // bounce more of full survival costs Mitsuba about a tenth more time and saves it
-    // about a sixth of its MSE (docs/PERFORMANCE.md, "Where the MSE gap is").
+    // bounce more of full survival costs Mitsuba 5-7% more time and saves it about a
+    // sixth of its MSE (docs/PERFORMANCE.md, "Where the MSE gap is").
     let roulette_depth = load_scene(SCENE)?.settings.roulette_depth;
     let out = python()
         .arg(script())

@@ -369,9 +369,9 @@ fn mitsuba_paragraph(peer: &Peer) -> String {
             "Mitsuba {version}: `xtask/peers/mitsuba_render.py` as `cargo xtask peers` runs it, \
              on `{MITSUBA_SCENE}` only (the shipped scene it can express), its `path` \
              integrator at max_depth {MAX_DEPTH} with independent samples, Russian \
-             roulette from lueur's `roulette_depth`, and all the machine's cores, timed by its render after a first one (`warm_s`): Python's \
-             start, the scene load and a JIT variant's kernel compile are not counted, which \
-             favours Mitsuba."
+             roulette from lueur's `roulette_depth`, and all the machine's cores, timed by \
+             its render after a first one (`warm_s`): Python's start, the scene load and a \
+             JIT variant's kernel compile are not counted, which favours Mitsuba."
         ),
         Peer::Skipped(why) => format!("Mitsuba 3: {why}."),
     }
