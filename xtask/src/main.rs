@@ -160,7 +160,13 @@ enum Command {
 }
 
 fn main() -> Result<()> {
-    match Cli::parse().command {
+    let command = Cli::parse().command;
+    // The probe runs inside a `memory` report, which holds the lock.
+    let _lock = match command {
+        Command::MemoryProbe { .. } => None,
+        _ => Some(report_lock()?),
+    };
+    match command {
         Command::Figures { quick } => figures::run(quick),
         Command::Variance { quick } => variance::run(quick),
         Command::Tradeoff { quick } => tradeoff::run(quick),
@@ -182,6 +188,32 @@ fn main() -> Result<()> {
             old_rev,
         } => instructions::run(quick, old.as_deref(), old_rev.as_deref()),
         Command::MemoryProbe { command } => memory::probe(&command),
+    }
+}
+
+/// An exclusive lock on `target/xtask/.lock`, held while a report runs. Two reports at
+/// once would share the machine's cores, each timing the other, and share the cache
+/// directories under `target/xtask` (two `memory` runs once met on one file there). The
+/// system releases the lock when the process ends, however it ends.
+fn report_lock() -> Result<std::fs::File> {
+    let path = reference::cache_dir()?.join(".lock");
+    let file = std::fs::File::options()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .with_context(|| format!("opening {}", path.display()))?;
+    match file.try_lock() {
+        Ok(()) => Ok(file),
+        Err(std::fs::TryLockError::WouldBlock) => anyhow::bail!(
+            "another `cargo xtask` report is running in this project (it holds {}): two at \
+             once would time each other and share their files under target/xtask; wait for \
+             it to finish",
+            path.display()
+        ),
+        Err(std::fs::TryLockError::Error(e)) => {
+            Err(e).with_context(|| format!("locking {}", path.display()))
+        }
     }
 }
 
