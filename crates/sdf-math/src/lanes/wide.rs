@@ -219,9 +219,9 @@ fn bits_from<T: MaskLane>(lanes: &[T], first: usize) -> u32 {
 /// All ones or all zeros per lane: what SSE, AVX2 and NEON compares write and their
 /// blends (or `and`, `andnot`, `or`) read. A select moves each lane's bits unchanged, as
 /// the scalar select does. AVX-512 takes this form too: LLVM moves it to and from the
-/// mask registers where an instruction needs them, and on the Intel Xeon measured its
-/// 16-lane streams ran 1.1x AVX2's with it, against 0.9x with a `bool` per lane
-/// (docs/PERFORMANCE.md, "Sixteen lanes with bit masks").
+/// mask registers where an instruction needs them. On the Intel Xeon measured, its 16
+/// lanes rendered at 1.09-1.15x AVX2's speed with it, and at 0.92-0.99x with a `bool`
+/// per lane (docs/PERFORMANCE.md, "Sixteen lanes with bit masks").
 impl MaskLane for u32 {
     #[inline(always)]
     fn from_bool(b: bool) -> u32 {
