@@ -41,14 +41,6 @@ static NIBBLES: LazyLock<Vec<[[u32; 16]; 8]>> = LazyLock::new(|| nibble_tables(|
 static REVERSED: LazyLock<Vec<[[u32; 16]; 8]>> =
     LazyLock::new(|| nibble_tables(|v, k| v[31 - k].reverse_bits()));
 
-/// Dimension 1's matrix in the bit-reversed *index* domain (the output is not reversed):
-/// `SECOND_AT_REVERSED[q][b]` is the XOR of the columns `31 - (4q + bit)` for the set bits
-/// of `b`, so that it maps `index.reverse_bits()` to `sobol_u32(index, 1)`. An
-/// Owen-scrambled index comes out reversed (Burley 2020), and the padded samplers read
-/// dimensions 0 and 1 there; 512 bytes.
-static SECOND_AT_REVERSED: LazyLock<[[u32; 16]; 8]> =
-    LazyLock::new(|| nibble_table(&MATRICES[1], |v, k| v[31 - k]));
-
 /// Per dimension, `table[q][b]` = XOR of `column(matrix, 4q + bit)` over the
 /// set bits of `b`: the shared construction of [`NIBBLES`] and [`REVERSED`].
 fn nibble_tables(column: impl Fn(&[u32; 32], usize) -> u32) -> Vec<[[u32; 16]; 8]> {
@@ -156,9 +148,29 @@ pub fn sobol_u32(index: u32, dimension: usize) -> u32 {
 pub fn sobol_u32_at_reversed_index(reversed_index: u32, dimension: usize) -> u32 {
     match dimension {
         0 => reversed_index,
-        1 => xor_nibbles(&SECOND_AT_REVERSED, reversed_index),
+        1 => second_at_reversed_index(reversed_index),
         _ => sobol_u32(reversed_index.reverse_bits(), dimension),
     }
+}
+
+/// Dimension 1 at the index `reversed_index.reverse_bits()`, unreversed: `sobol_u32(index,
+/// 1)`, in five shifts instead of a table's eight reads. Dimension 1's matrix is Pascal's
+/// triangle mod 2 (its primitive polynomial is `x + 1` and every `m_k` is 1), so with the
+/// index's bits as the coefficients of a polynomial `I(t)` the point's bits, from the top,
+/// are those of `I(t + 1)`. Over GF(2), `(t + 1)^p` is the product of `t^s + 1` over the
+/// powers of two `s` in `p` (Frobenius: `(t + 1)^(2^m) = t^(2^m) + 1`), so the substitution
+/// is one pass per bit of the exponent: each term whose exponent has bit `s` also adds the
+/// term `s` lower. In the reversed domain, lower exponents are higher bits, hence the left
+/// shifts, and the masks are the reversed ones.
+#[inline]
+fn second_at_reversed_index(reversed_index: u32) -> u32 {
+    let mut y = reversed_index;
+    y ^= (y & 0x5555_5555) << 1;
+    y ^= (y & 0x3333_3333) << 2;
+    y ^= (y & 0x0f0f_0f0f) << 4;
+    y ^= (y & 0x00ff_00ff) << 8;
+    y ^= (y & 0x0000_ffff) << 16;
+    y
 }
 
 /// The Laine–Karras permutation with Burley's improved constants: a hash
@@ -261,6 +273,21 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn the_second_dimension_by_shifts_is_its_matrix() {
+        // Both maps are linear over GF(2), so agreeing on the 32 one-bit indices they agree
+        // on every index.
+        for k in 0..32 {
+            let index = 1u32 << k;
+            assert_eq!(
+                second_at_reversed_index(index.reverse_bits()),
+                MATRICES[1][k],
+                "index bit {k}"
+            );
+        }
+        assert_eq!(second_at_reversed_index(0), 0);
     }
 
     #[test]

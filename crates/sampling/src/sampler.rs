@@ -367,7 +367,12 @@ impl Sampler {
             self.stream_position = self.stream_position.wrapping_add(1);
             return (self.rng.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0);
         }
-        let value = self.sample_1d();
+        // The default kind inline, the others through `sample_1d`'s table.
+        let value = if self.kind == SamplerKind::SobolXor {
+            fraction_to_f32(self.padded_sobol::<1>()[0])
+        } else {
+            self.sample_1d()
+        };
         self.dimension = self.dimension.wrapping_add(1);
         value
     }
@@ -382,7 +387,12 @@ impl Sampler {
             let y = self.next_1d();
             return Vec2::new(x, y);
         }
-        let value = self.sample_2d();
+        let value = if self.kind == SamplerKind::SobolXor {
+            let [x, y] = self.padded_sobol::<2>();
+            Vec2::new(fraction_to_f32(x), fraction_to_f32(y))
+        } else {
+            self.sample_2d()
+        };
         self.dimension = self.dimension.wrapping_add(2);
         value
     }
@@ -553,14 +563,21 @@ impl Sampler {
         // scramble's last step undone), where dimensions 0 and 1 read it directly.
         let index = laine_karras_permutation(self.reversed_index, h as u32);
         let seeds = [(h >> 32) as u32, hash2(h, 1) as u32];
-        std::array::from_fn(|k| {
-            let x = sobol_u32_at_reversed_index(index, k);
+        // Dimension by dimension, not over a loop's index: each reads its own matrix
+        // inline (a loop's `k` left the choice of matrix to run time, out of line).
+        let scrambled = |x: u32, seed: u32| {
             if self.kind == SamplerKind::SobolXor {
-                x ^ seeds[k]
+                x ^ seed
             } else {
-                nested_uniform_scramble(x, seeds[k])
+                nested_uniform_scramble(x, seed)
             }
-        })
+        };
+        let mut out = [0; N];
+        out[0] = scrambled(sobol_u32_at_reversed_index(index, 0), seeds[0]);
+        if N == 2 {
+            out[1] = scrambled(sobol_u32_at_reversed_index(index, 1), seeds[1]);
+        }
+        out
     }
 
     /// pbrt-v4's `ZSobolSampler::Get1D/Get2D`: Owen-scrambled Sobol' (0, 2)
