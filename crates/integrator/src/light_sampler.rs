@@ -22,6 +22,16 @@ pub(crate) enum Emitter {
     Sky,
 }
 
+/// A chosen emitter's direction sample that a wave drew with its others.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Drawn<'a> {
+    /// A light's ([`SphereDraws`], [`RectangleDraws`]).
+    Light(&'a Option<DirectionSample>),
+    /// The sky's cosine-weighted direction in the normal's frame
+    /// ([`crate::strategy::CosineDraws`]).
+    Cosine(Vec3),
+}
+
 /// The choice among emitters: uniform over the lights that are not delta
 /// distributions, then the sky if there is one.
 #[derive(Clone, Debug)]
@@ -129,8 +139,15 @@ impl Emitters<'_> {
         }
     }
 
-    /// [`Emitters::sample`], where the chosen light's direction sample was `drawn`
-    /// already ([`Light::sample_drawn`]).
+    /// Whether `u_choice` makes [`Emitters::sample`] aim at the sky, whose cosine-weighted
+    /// directions a wave draws with its others ([`crate::strategy::CosineDraws`]).
+    #[inline]
+    pub fn chosen_sky(&self, u_choice: f32) -> bool {
+        self.sky.is_some() && matches!(self.sampler.choose(u_choice), Some((Emitter::Sky, _)))
+    }
+
+    /// [`Emitters::sample`], where the chosen emitter's direction sample was `drawn`
+    /// already ([`Light::sample_drawn`], or the sky's local direction).
     #[inline]
     pub fn sample_drawn(
         &self,
@@ -138,13 +155,19 @@ impl Emitters<'_> {
         n: Vec3,
         u_choice: f32,
         u: Vec2,
-        drawn: Option<&Option<DirectionSample>>,
+        drawn: Option<Drawn<'_>>,
     ) -> Option<(EmitterSample, Option<usize>)> {
         let (emitter, pmf) = self.sampler.choose(u_choice)?;
         match emitter {
             Emitter::Sky => {
                 let sky = self.sky?;
-                let local = sample_cosine_hemisphere(u);
+                let local = match drawn {
+                    Some(Drawn::Cosine(local)) => {
+                        debug_assert_eq!(local, sample_cosine_hemisphere(u));
+                        local
+                    }
+                    _ => sample_cosine_hemisphere(u),
+                };
                 let pdf = cosine_hemisphere_pdf(local.z);
                 if !(pdf > 0.0) {
                     return None;
@@ -162,6 +185,10 @@ impl Emitters<'_> {
             }
             Emitter::Light(i) => {
                 let light = &self.lights[i];
+                let drawn = match drawn {
+                    Some(Drawn::Light(drawn)) => Some(drawn),
+                    _ => None,
+                };
                 let s = match (drawn, self.rectangle(i)) {
                     (None, Some(frame)) => {
                         light.sample_drawn(p, u, self.quad_sampling, Some(&frame.sample(p, u)))

@@ -8,7 +8,7 @@ use std::collections::VecDeque;
 
 use glam::Vec3;
 use lueur_materials::Material;
-use lueur_sampling::{DirectionSample, Sampler};
+use lueur_sampling::Sampler;
 use lueur_sdf_math::{Ray, SimdLevel};
 
 use lueur_sdf_math::TraceParams;
@@ -18,7 +18,7 @@ use crate::surface::{March, SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::{PathRay, RayCounters, ShadowRay, TraceScratch, Tracing};
 use lueur_scene::RenderSettings;
 
-use crate::light_sampler::{Emitters, RectangleDraws, SphereDraws};
+use crate::light_sampler::{Drawn, Emitters, RectangleDraws, SphereDraws};
 use crate::{Hit, PreparedScene};
 
 /// State carried from one vertex to the next for weighting emission.
@@ -137,11 +137,12 @@ struct Pending {
 }
 
 /// Where a wave drew a vertex's light sample: its index in the wave's [`SphereDraws`] or
-/// [`RectangleDraws`].
+/// [`RectangleDraws`], or, toward the sky, in its [`CosineDraws`].
 #[derive(Clone, Copy)]
 enum LightDraw {
     Sphere(usize),
     Rectangle(usize),
+    Sky(usize),
 }
 
 /// The light samples a wave draws together.
@@ -163,12 +164,13 @@ impl LightDraws {
         self.rectangles.draw(emitters);
     }
 
-    /// The sample `light` names, drawn.
+    /// The sample `light` names, drawn (the sky's among the wave's `cosines`).
     #[inline(always)]
-    fn drawn(&self, light: LightDraw) -> &Option<DirectionSample> {
+    fn drawn<'a>(&'a self, light: LightDraw, cosines: &CosineDraws) -> Drawn<'a> {
         match light {
-            LightDraw::Sphere(k) => &self.spheres.drawn[k],
-            LightDraw::Rectangle(k) => &self.rectangles.drawn[k],
+            LightDraw::Sphere(k) => Drawn::Light(&self.spheres.drawn[k]),
+            LightDraw::Rectangle(k) => Drawn::Light(&self.rectangles.drawn[k]),
+            LightDraw::Sky(k) => Drawn::Cosine(cosines.drawn[k]),
         }
     }
 }
@@ -269,7 +271,7 @@ fn shade(
             // the ray is stored in pieces and loaded whole, and the load waits for the
             // stores.
             out.next_event = strategy::uses_next_event(settings.strategy)
-                && match lighting.next_event(&vertex, u, light.map(|l| lights.drawn(l))) {
+                && match lighting.next_event(&vertex, u, light.map(|l| lights.drawn(l, cosines))) {
                     Some((ray, contribution)) => {
                         shadow.rays.push(ray);
                         shadow.contributions.push(contribution);
@@ -452,7 +454,7 @@ pub(crate) fn radiance_wave(
                 settings.strategy,
             );
             let u = &pending.u;
-            // Next-event estimation toward a sphere or rectangle light, and the
+            // Next-event estimation toward a sphere or rectangle light or the sky, and the
             // cosine-weighted direction a diffuse vertex scatters in: drawn below, with the
             // wave's others.
             let diffuse = matches!(material_at(scene, on_surface), Material::Lambertian { .. });
@@ -463,11 +465,13 @@ pub(crate) fn radiance_wave(
             } else if let Some(sphere) = emitters.chosen_sphere(u.emitter_choice) {
                 let k = s.lights.spheres.request(surface.p, sphere, u.emitter);
                 Some(LightDraw::Sphere(k))
+            } else if let Some(light) = emitters.chosen_rectangle(u.emitter_choice) {
+                let k = s.lights.rectangles.request(surface.p, light, u.emitter);
+                Some(LightDraw::Rectangle(k))
             } else {
-                emitters.chosen_rectangle(u.emitter_choice).map(|light| {
-                    let k = s.lights.rectangles.request(surface.p, light, u.emitter);
-                    LightDraw::Rectangle(k)
-                })
+                emitters
+                    .chosen_sky(u.emitter_choice)
+                    .then(|| LightDraw::Sky(s.cosines.request(u.emitter)))
             };
             pending.cosine = (diffuse && strategy::scatters_by_cosine(settings.strategy))
                 .then(|| s.cosines.request(u.bsdf));

@@ -8,10 +8,10 @@
 
 use glam::{Vec2, Vec3};
 use lueur_materials::{HemisphereSampling, Material};
-use lueur_sampling::{DirectionSample, Sampler, power_heuristic, sample_cosine_hemisphere_lanes};
+use lueur_sampling::{Sampler, power_heuristic, sample_cosine_hemisphere_lanes};
 use lueur_sdf_math::{Lane, LaneKernel, MAX_LANES, Ray, SimdLevel, TraceParams};
 
-use crate::light_sampler::Emitters;
+use crate::light_sampler::{Drawn, Emitters};
 use crate::surface::{March, SurfacePoint};
 use lueur_scene::{RenderSettings, Strategy};
 
@@ -478,15 +478,15 @@ impl<'a> Lighting<'a> {
     /// sampling by [`next_event_weight`]: what it brings if its shadow ray is free, with
     /// that ray; `None` where it brings nothing whatever the ray finds.
     ///
-    /// `drawn` is the chosen light's direction sample where the wave drew it already
-    /// ([`crate::light_sampler::SphereDraws`], [`crate::light_sampler::RectangleDraws`]),
-    /// `None` otherwise.
+    /// `drawn` is the chosen emitter's direction sample where the wave drew it already
+    /// ([`crate::light_sampler::SphereDraws`], [`crate::light_sampler::RectangleDraws`],
+    /// or the sky's in [`CosineDraws`]), `None` otherwise.
     #[inline]
     pub fn next_event(
         &self,
         v: &Vertex<'_>,
         u: &VertexSample,
-        drawn: Option<&Option<DirectionSample>>,
+        drawn: Option<Drawn<'_>>,
     ) -> Option<(ShadowRay, Vec3)> {
         let (n, wo) = (v.at.n, v.wo);
         let (es, light) =
@@ -693,13 +693,57 @@ mod tests {
                 let alone = scene.scene().lights[light].sample(p, e, quads);
                 assert_eq!(draws.drawn[k].map(|d| d.wi), alone.map(|s| s.wi), "{p} {e}");
                 let n = Vec3::Y;
-                let through = emitters.sample_drawn(p, n, choice, e, Some(&draws.drawn[k]));
+                let through =
+                    emitters.sample_drawn(p, n, choice, e, Some(Drawn::Light(&draws.drawn[k])));
                 assert_eq!(through, emitters.sample(p, n, choice, e));
                 assert_eq!(through.map(|(s, _)| s.wi), alone.map(|s| s.wi));
                 sampled += usize::from(alone.is_some());
             }
             assert!(sampled > 10, "only {sampled} samples had weight");
         }
+    }
+
+    /// Next-event estimation toward the sky with its direction drawn among a wave's cosine
+    /// draws gives the bits of the sky sampled alone, on every level; and only the sky's
+    /// choices ask for one.
+    #[test]
+    fn sky_draws_are_each_sample_alone() {
+        let scene = scene(true);
+        let emitters = scene.emitters(QuadSampling::default());
+        let mut u = uniforms(13);
+        let asked: Vec<(f32, Vec2, Vec3)> = (0..200)
+            .map(|_| {
+                let n = Vec3::new(u() - 0.5, u() - 0.5, u() - 0.5).normalize();
+                (u(), Vec2::new(u(), u()), n)
+            })
+            .filter(|&(choice, ..)| emitters.chosen_sky(choice))
+            .collect();
+        assert!(asked.len() > 30, "only {} sky choices", asked.len());
+        for level in SimdLevel::available() {
+            let mut draws = CosineDraws::default();
+            let indices: Vec<usize> = asked.iter().map(|&(_, e, _)| draws.request(e)).collect();
+            draws.draw(level);
+            for (&k, &(choice, e, n)) in indices.iter().zip(&asked) {
+                let p = Vec3::ZERO;
+                let through =
+                    emitters.sample_drawn(p, n, choice, e, Some(Drawn::Cosine(draws.drawn[k])));
+                let alone = emitters.sample(p, n, choice, e);
+                assert!(alone.is_some_and(|(_, light)| light.is_none()), "the sky");
+                assert_eq!(through, alone, "{level:?}: {choice} {e} {n}");
+            }
+        }
+        let agrees = sky_is_chosen_where_sampled(&emitters);
+        assert!(agrees, "chosen_sky agrees with what sampling picks");
+    }
+
+    /// Whether `chosen_sky` holds exactly for the choices that sampling aims at the sky.
+    fn sky_is_chosen_where_sampled(emitters: &Emitters<'_>) -> bool {
+        (0..1000).map(|i| i as f32 / 1000.0).all(|choice| {
+            emitters.chosen_sky(choice)
+                == emitters
+                    .sample(Vec3::ZERO, Vec3::Y, choice, Vec2::splat(0.5))
+                    .is_some_and(|(_, light)| light.is_none())
+        })
     }
 
     fn reported(s: Scatter) -> (Vec3, f32) {
