@@ -189,6 +189,33 @@ impl<L: Lane> Slope<L> {
     }
 }
 
+/// Whether every lane of `lanes` is empty and finite in `(lo, hi)` (`lo > hi` holds for
+/// no NaN): [`RayClipLanes::clip_box_lanes_in`]'s early answer. Not a closure: a vector
+/// kernel inlines only what is marked to be inlined.
+#[inline(always)]
+fn box_misses<L: Lane>(clip: &RayClipLanes<L>, (lo, hi): (L, L), lanes: u32) -> bool {
+    let empty = L::and(lo.gt(hi), L::not(clip.degenerate));
+    lanes != 0 && L::bits(empty) & lanes == lanes
+}
+
+/// The interval of each lane's ray within the box's slab on `axis`.
+#[inline(always)]
+fn box_axis<L: Lane>(clip: &RayClipLanes<L>, aabb: &Aabb, axis: usize) -> (L, L) {
+    let [up, down] = &clip.families;
+    let (t_min, t_max) = (clip.t_min, clip.t_max);
+    let o = component(clip.origin, axis);
+    let (min, max) = (L::splat(aabb.min[axis]), L::splat(aabb.max[axis]));
+    // Taken off every plane value: the f32 rounding of the numbers that decide it, per
+    // axis (the origin's coordinate and the box's faces on that axis). Per axis, not the
+    // largest coordinate of all, so that a ray leaving the top of a floor 1e4 wide is not
+    // a candidate for it however close above it starts.
+    let scale = o.abs().max_cmp(min.abs()).max_cmp(max.abs());
+    let slack = L::splat(4.0 * f32::EPSILON) * scale + clip.eps_abs;
+    let (lo_up, hi_up) = up.below(axis, o - max - slack, t_min, t_max);
+    let (lo_down, hi_down) = down.below(axis, min - o - slack, t_min, t_max);
+    (lo_up.max_cmp(lo_down), hi_up.min_cmp(hi_down))
+}
+
 /// Coordinate `axis` (0, 1 or 2) of `v`.
 #[inline(always)]
 fn component<L: Lane>(v: LaneVec3<L>, axis: usize) -> L {
@@ -357,48 +384,56 @@ impl<L: Lane> RayClipLanes<L> {
     /// computed. Exact: such a lane is not kept whatever the other axes give (the
     /// intersection is empty and neither bound is NaN), and a ray that is not finite is
     /// never found empty. Most boxes miss every ray of a vector (two thirds of them in
-    /// the Cornell box), and one axis often says so.
+    /// the Cornell box), and one axis often says so: the box's thinnest, first. A wall's
+    /// thin axis alone drops every ray that leaves it behind, where a long axis drops
+    /// none of the rays that start within its span (every ray inside a room).
     #[inline(always)]
     pub fn clip_box_lanes_in(&self, aabb: &Aabb, lanes: u32) -> Option<(L, L, L::Mask)> {
-        // Every lane in `lanes` empty and finite (`lo > hi` holds for no NaN). Not a
-        // closure: a vector kernel inlines only what is marked to be inlined.
-        #[inline(always)]
-        fn misses<L: Lane>(clip: &RayClipLanes<L>, (lo, hi): (L, L), lanes: u32) -> bool {
-            let empty = L::and(lo.gt(hi), L::not(clip.degenerate));
-            lanes != 0 && L::bits(empty) & lanes == lanes
+        let e = aabb.max - aabb.min;
+        if e.x < e.y && e.x < e.z {
+            self.clip_box_lanes_from::<0>(aabb, lanes)
+        } else if e.y < e.z {
+            self.clip_box_lanes_from::<1>(aabb, lanes)
+        } else {
+            self.clip_box_lanes_from::<2>(aabb, lanes)
         }
+    }
+
+    /// [`RayClipLanes::clip_box_lanes_in`], testing axis `FIRST` alone, then with the
+    /// next, then the third. The interval is the same bits in any order: the axes'
+    /// bounds are never NaN for a ray that is kept by them (finite, non-degenerate), so
+    /// their maximum and minimum do not depend on the order taken; it is still taken as
+    /// `max_element` and `min_element` take it, `x` with `(y, z)`.
+    #[inline(always)]
+    fn clip_box_lanes_from<const FIRST: usize>(
+        &self,
+        aabb: &Aabb,
+        lanes: u32,
+    ) -> Option<(L, L, L::Mask)> {
         let (t_min, t_max) = (self.t_min, self.t_max);
-        // One axis at a time, each folded into the intersection before the next, so that
-        // what is live at once fits the vector registers (all three axes' sets at once
-        // did not, and were spilled and reloaded). Not a closure: a vector kernel inlines
-        // only what is marked to be inlined.
-        #[inline(always)]
-        fn axis<L: Lane>(clip: &RayClipLanes<L>, aabb: &Aabb, axis: usize) -> (L, L) {
-            let [up, down] = &clip.families;
-            let (t_min, t_max) = (clip.t_min, clip.t_max);
-            let o = component(clip.origin, axis);
-            let (min, max) = (L::splat(aabb.min[axis]), L::splat(aabb.max[axis]));
-            // Taken off every plane value: the f32 rounding of the numbers that decide it,
-            // per axis (the origin's coordinate and the box's faces on that axis). Per
-            // axis, not the largest coordinate of all, so that a ray leaving the top of a
-            // floor 1e4 wide is not a candidate for it however close above it starts.
-            let scale = o.abs().max_cmp(min.abs()).max_cmp(max.abs());
-            let slack = L::splat(4.0 * f32::EPSILON) * scale + clip.eps_abs;
-            let (lo_up, hi_up) = up.below(axis, o - max - slack, t_min, t_max);
-            let (lo_down, hi_down) = down.below(axis, min - o - slack, t_min, t_max);
-            (lo_up.max_cmp(lo_down), hi_up.min_cmp(hi_down))
-        }
-        // Over the axes, as `max_element` and `min_element` take them: `x` with `(y, z)`.
-        let (lo_z, hi_z) = axis(self, aabb, 2);
-        if misses(self, (lo_z, hi_z), lanes) {
+        // One axis at a time, each folded into the intersection before it is tested, so
+        // that what is live at once fits the vector registers (all three axes' sets
+        // computed at once did not, and were spilled and reloaded).
+        let (second, third) = match FIRST {
+            0 => (2, 1),
+            1 => (2, 0),
+            _ => (1, 0),
+        };
+        let a = box_axis(self, aabb, FIRST);
+        if box_misses(self, a, lanes) {
             return None;
         }
-        let (lo_y, hi_y) = axis(self, aabb, 1);
+        let b = box_axis(self, aabb, second);
+        if box_misses(self, (a.0.max_cmp(b.0), a.1.min_cmp(b.1)), lanes) {
+            return None;
+        }
+        let c = box_axis(self, aabb, third);
+        let ((lo_x, hi_x), (lo_y, hi_y), (lo_z, hi_z)) = match FIRST {
+            0 => (a, c, b),
+            1 => (c, a, b),
+            _ => (c, b, a),
+        };
         let (lo_yz, hi_yz) = (lo_y.max_cmp(lo_z), hi_y.min_cmp(hi_z));
-        if misses(self, (lo_yz, hi_yz), lanes) {
-            return None;
-        }
-        let (lo_x, hi_x) = axis(self, aabb, 0);
         let t0 = lo_x.max_cmp(lo_yz).max(t_min);
         let t1 = hi_x.min_cmp(hi_yz).min(t_max);
         let (t0, t1, kept) = widen(t0, t1, t_min, t_max);
@@ -534,7 +569,8 @@ mod tests {
     }
 
     /// The early answer of `clip_box_lanes_in` is exact: where it says no lane keeps the
-    /// box, the whole computation keeps none of them; elsewhere it gives the same bits.
+    /// box, the whole computation keeps none of them; elsewhere it gives the same bits,
+    /// as does testing any axis first.
     /// Over rays near, inside, along and far from boxes from 1e-4 to 1e4 wide, at
     /// coordinates up to 1e4, with degenerate rays and ranges among them.
     #[test]
@@ -571,13 +607,21 @@ mod tests {
             };
             let clip = RayClip::new(&Ray::new(origin, dir), &params);
             let whole = clip.clip_box_lanes(&aabb);
+            let bits = |(a, b, k): (f32, f32, bool)| (a.to_bits(), b.to_bits(), k);
+            // Whichever axis is tested first, the same bits.
+            for from in [
+                clip.clip_box_lanes_from::<0>(&aabb, 0),
+                clip.clip_box_lanes_from::<1>(&aabb, 0),
+                clip.clip_box_lanes_from::<2>(&aabb, 0),
+            ] {
+                assert_eq!(from.map(bits), Some(bits(whole)), "ray {i}");
+            }
             match clip.clip_box_lanes_in(&aabb, 1) {
                 None => {
                     early += 1;
                     assert!(!whole.2, "ray {i}: kept by the whole clip");
                 }
                 Some(got) => {
-                    let bits = |(a, b, k): (f32, f32, bool)| (a.to_bits(), b.to_bits(), k);
                     assert_eq!(bits(got), bits(whole), "ray {i}");
                 }
             }
