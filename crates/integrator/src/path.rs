@@ -170,7 +170,7 @@ impl LightDraws {
         match light {
             LightDraw::Sphere(k) => Drawn::Light(&self.spheres.drawn[k]),
             LightDraw::Rectangle(k) => Drawn::Light(&self.rectangles.drawn[k]),
-            LightDraw::Sky(k) => Drawn::Cosine(cosines.drawn[k]),
+            LightDraw::Sky(k) => Drawn::Cosine(cosines.drawn(k)),
         }
     }
 }
@@ -279,7 +279,7 @@ fn shade(
                     }
                     None => false,
                 };
-            let cosine = cosine.map(|k| cosines.drawn[k]);
+            let cosine = cosine.map(|k| cosines.drawn(k));
             let emitters = &lighting.emitters;
             strategy::scatter_into(
                 settings.strategy,

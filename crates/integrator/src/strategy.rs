@@ -241,15 +241,33 @@ pub(crate) struct CosineDraws {
     /// Per request, its two numbers, padded with zeros to whole vectors when drawn.
     u0: Vec<f32>,
     u1: Vec<f32>,
-    /// Per request, after [`CosineDraws::draw`]: its direction.
-    pub drawn: Vec<Vec3>,
+    /// Per request, after [`CosineDraws::draw`]: its direction's coordinates, one row
+    /// each, as the kernel stores its vectors (a `Vec3` per lane, picked out of them one
+    /// at a time, took most of the kernel's time).
+    drawn: [Vec<f32>; 3],
+    /// How many requests were drawn.
+    len: usize,
 }
 
 impl CosineDraws {
     pub fn clear(&mut self) {
         self.u0.clear();
         self.u1.clear();
-        self.drawn.clear();
+        self.len = 0;
+    }
+
+    /// Request `k`'s direction, after [`CosineDraws::draw`].
+    #[inline(always)]
+    pub fn drawn(&self, k: usize) -> Vec3 {
+        debug_assert!(k < self.len);
+        let [x, y, z] = &self.drawn;
+        Vec3::new(x[k], y[k], z[k])
+    }
+
+    /// How many requests were drawn.
+    #[cfg(test)]
+    pub fn len(&self) -> usize {
+        self.len
     }
 
     /// Asks for the direction of `u`; its index in `drawn`.
@@ -261,15 +279,19 @@ impl CosineDraws {
 
     /// Draws every request's direction on `level` (the widest available where it is not).
     pub fn draw(&mut self, level: SimdLevel) {
-        self.drawn.clear();
         let n = self.u0.len();
+        self.len = n;
         if n == 0 {
             return;
         }
-        // Whole vectors of the widest level, so that every load is of a known length.
+        // Whole vectors of the widest level, so that every load and store is of a known
+        // length.
         let padded = n.next_multiple_of(MAX_LANES);
         self.u0.resize(padded, 0.0);
         self.u1.resize(padded, 0.0);
+        for row in &mut self.drawn {
+            row.resize(padded, 0.0);
+        }
         // The level is available: `or_widest` says so.
         let _ = level.or_widest().dispatch(DrawCosines {
             u: [&self.u0, &self.u1],
@@ -283,7 +305,7 @@ impl CosineDraws {
 struct DrawCosines<'a> {
     u: [&'a [f32]; 2],
     n: usize,
-    drawn: &'a mut Vec<Vec3>,
+    drawn: &'a mut [Vec<f32>; 3],
 }
 
 impl LaneKernel for DrawCosines<'_> {
@@ -294,20 +316,18 @@ impl LaneKernel for DrawCosines<'_> {
         let DrawCosines {
             u: [u0, u1],
             n,
-            drawn,
+            drawn: [x, y, z],
         } = self;
         let width = L::LANES.min(MAX_LANES);
-        let mut out = [[0f32; MAX_LANES]; 3];
         for start in (0..n).step_by(width) {
             let lanes = start..start + width;
-            let d =
-                sample_cosine_hemisphere_lanes([L::load(&u0[lanes.clone()]), L::load(&u1[lanes])]);
-            for (row, v) in out.iter_mut().zip([d.x, d.y, d.z]) {
-                v.store(&mut row[..width]);
-            }
-            drawn.extend(
-                (0..width.min(n - start)).map(|k| Vec3::new(out[0][k], out[1][k], out[2][k])),
-            );
+            let d = sample_cosine_hemisphere_lanes([
+                L::load(&u0[lanes.clone()]),
+                L::load(&u1[lanes.clone()]),
+            ]);
+            d.x.store(&mut x[lanes.clone()]);
+            d.y.store(&mut y[lanes.clone()]);
+            d.z.store(&mut z[lanes]);
         }
     }
 }
@@ -650,10 +670,10 @@ mod tests {
                 let mut draws = CosineDraws::default();
                 let indices: Vec<usize> = requests[..n].iter().map(|&u| draws.request(u)).collect();
                 draws.draw(level);
-                assert_eq!(draws.drawn.len(), n);
+                assert_eq!(draws.len(), n);
                 for (&k, &u) in indices.iter().zip(&requests) {
                     let alone = lueur_sampling::sample_cosine_hemisphere(u);
-                    assert_eq!(draws.drawn[k], alone, "{level:?}, {n} requests, u = {u}");
+                    assert_eq!(draws.drawn(k), alone, "{level:?}, {n} requests, u = {u}");
                 }
             }
         }
@@ -726,7 +746,7 @@ mod tests {
             for (&k, &(choice, e, n)) in indices.iter().zip(&asked) {
                 let p = Vec3::ZERO;
                 let through =
-                    emitters.sample_drawn(p, n, choice, e, Some(Drawn::Cosine(draws.drawn[k])));
+                    emitters.sample_drawn(p, n, choice, e, Some(Drawn::Cosine(draws.drawn(k))));
                 let alone = emitters.sample(p, n, choice, e);
                 assert!(alone.is_some_and(|(_, light)| light.is_none()), "the sky");
                 assert_eq!(through, alone, "{level:?}: {choice} {e} {n}");
