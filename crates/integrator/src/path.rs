@@ -13,7 +13,9 @@ use lueur_sdf_math::{Ray, SimdLevel};
 
 use lueur_sdf_math::TraceParams;
 
-use crate::strategy::{self, CosineDraws, EmissionWeight, Lighting, Scatter, Vertex, VertexSample};
+use crate::strategy::{
+    self, CosineDraws, CosineScatters, EmissionWeight, Lighting, Scatter, Vertex, VertexSample,
+};
 use crate::surface::{March, SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::{PathRay, RayCounters, ShadowRay, TraceScratch, Tracing};
 use lueur_scene::RenderSettings;
@@ -125,8 +127,8 @@ impl Shaded {
 }
 
 /// A vertex waiting to be shaded: its path, the object it met, its numbers, where the wave
-/// drew its next-event estimation's light sample, and its direction's index in the wave's
-/// [`CosineDraws`] where it scatters by the cosine. Its shading point is the wave's
+/// drew its next-event estimation's light sample, and its sample's index in the wave's
+/// [`CosineScatters`] where it scatters by the cosine. Its shading point is the wave's
 /// [`SurfacePoint`] of the same index.
 struct Pending {
     path: usize,
@@ -199,6 +201,7 @@ pub(crate) struct WaveScratch {
     pending: Vec<Pending>,
     lights: LightDraws,
     cosines: CosineDraws,
+    scatters: CosineScatters,
     shaded: Vec<Shaded>,
     shadow: ShadowQueue,
     free: Vec<bool>,
@@ -227,7 +230,7 @@ fn shade(
     estimator: &Estimator<'_>,
     lighting: &Lighting<'_>,
     (pending, surface, path): (&Pending, &SurfacePoint, &Path),
-    (lights, cosines): (&LightDraws, &CosineDraws),
+    (lights, cosines, scatters): (&LightDraws, &CosineDraws, &CosineScatters),
     shadow: &mut ShadowQueue,
     out: &mut Shaded,
 ) {
@@ -279,7 +282,7 @@ fn shade(
                     }
                     None => false,
                 };
-            let cosine = cosine.map(|k| cosines.drawn(k));
+            let cosine = cosine.map(|k| scatters.drawn(k));
             let emitters = &lighting.emitters;
             strategy::scatter_into(
                 settings.strategy,
@@ -419,6 +422,7 @@ pub(crate) fn radiance_wave(
         s.pending.clear();
         s.lights.clear();
         s.cosines.clear();
+        s.scatters.clear(s.active.len());
         let mut surfaces = s.surfaces.iter();
         for (&i, &hit) in s.active.iter().zip(&s.hits) {
             let path = &mut s.paths[i];
@@ -457,7 +461,11 @@ pub(crate) fn radiance_wave(
             // Next-event estimation toward a sphere or rectangle light or the sky, and the
             // cosine-weighted direction a diffuse vertex scatters in: drawn below, with the
             // wave's others.
-            let diffuse = matches!(material_at(scene, on_surface), Material::Lambertian { .. });
+            let albedo = match material_at(scene, on_surface) {
+                Material::Lambertian { albedo } => Some(albedo),
+                Material::Mirror { .. } => None,
+            };
+            let diffuse = albedo.is_some();
             let next_event = strategy::uses_next_event(settings.strategy) && diffuse;
             let emitters = &lighting.emitters;
             pending.light = if !next_event {
@@ -473,14 +481,16 @@ pub(crate) fn radiance_wave(
                     .chosen_sky(u.emitter_choice)
                     .then(|| LightDraw::Sky(s.cosines.request(u.emitter)))
             };
-            pending.cosine = (diffuse && strategy::scatters_by_cosine(settings.strategy))
-                .then(|| s.cosines.request(u.bsdf));
+            pending.cosine = albedo
+                .filter(|_| strategy::scatters_by_cosine(settings.strategy))
+                .map(|albedo| s.scatters.request(u.bsdf, albedo, -path.ray.dir, surface.n));
         }
         // The shading below and the scattering after pair each vertex with its shading
         // point by index.
         debug_assert_eq!(s.pending.len(), s.surfaces.len());
         s.lights.draw(tracing.simd, &lighting.emitters);
         s.cosines.draw(tracing.simd);
+        s.scatters.draw(tracing.simd);
 
         s.shaded.resize(s.pending.len(), Shaded::UNSET);
         s.shadow.rays.clear();
@@ -491,7 +501,7 @@ pub(crate) fn radiance_wave(
                 estimator,
                 &lighting,
                 (pending, surface, path),
-                (&s.lights, &s.cosines),
+                (&s.lights, &s.cosines, &s.scatters),
                 &mut s.shadow,
                 out,
             );

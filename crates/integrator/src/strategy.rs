@@ -7,9 +7,11 @@
 //! can call them per ray.
 
 use glam::{Vec2, Vec3};
-use lueur_materials::{HemisphereSampling, Material};
+use lueur_materials::{CosineScatterLanes, HemisphereSampling, Material};
 use lueur_sampling::{Sampler, power_heuristic, sample_cosine_hemisphere_lanes};
-use lueur_sdf_math::{Lane, LaneKernel, MAX_LANES, Ray, SimdLevel, TraceParams};
+use lueur_sdf_math::{
+    Lane, LaneKernel, LaneVec3, MAX_LANES, Ray, SimdLevel, TraceParams, write_lane,
+};
 
 use crate::light_sampler::{Drawn, Emitters};
 use crate::surface::{March, SurfacePoint};
@@ -160,15 +162,15 @@ pub(crate) fn mirror(v: &Vertex<'_>, u_bsdf: Vec2) -> Option<Scatter> {
     })
 }
 
-/// The direction of `strategy` at a diffuse vertex; `cosine` is the cosine-weighted local
-/// direction of `u.bsdf` where it was drawn already ([`CosineDraws`]).
+/// The direction of `strategy` at a diffuse vertex; `cosine` is the BSDF's sample of
+/// `u.bsdf` by the cosine where the wave drew it already ([`CosineScatters`]).
 #[inline]
 pub(crate) fn scatter(
     strategy: Strategy,
     emitters: &Emitters<'_>,
     v: &Vertex<'_>,
     u: &VertexSample,
-    cosine: Option<Vec3>,
+    cosine: Option<Option<DrawnScatter>>,
 ) -> Option<Scatter> {
     match strategy {
         Strategy::Uniform => hemisphere(v, HemisphereSampling::Uniform, u.bsdf, None),
@@ -189,7 +191,7 @@ pub(crate) fn scatter_into(
     emitters: &Emitters<'_>,
     v: &Vertex<'_>,
     u: &VertexSample,
-    cosine: Option<Vec3>,
+    cosine: Option<Option<DrawnScatter>>,
     out: &mut Option<Scatter>,
 ) {
     if strategy == Strategy::Mis {
@@ -205,7 +207,7 @@ fn scatter_out_of_line(
     emitters: &Emitters<'_>,
     v: &Vertex<'_>,
     u: &VertexSample,
-    cosine: Option<Vec3>,
+    cosine: Option<Option<DrawnScatter>>,
     out: &mut Option<Scatter>,
 ) {
     *out = scatter(strategy, emitters, v, u, cosine);
@@ -221,7 +223,7 @@ fn samples_emitters(strategy: Strategy) -> bool {
 }
 
 /// Whether `strategy` scatters from a diffuse vertex by cosine sampling, whose
-/// directions a wave draws in lanes ([`CosineDraws`]).
+/// samples a wave draws in lanes ([`CosineScatters`]).
 pub(crate) fn scatters_by_cosine(strategy: Strategy) -> bool {
     match strategy {
         Strategy::Cosine => true,
@@ -332,6 +334,144 @@ impl LaneKernel for DrawCosines<'_> {
     }
 }
 
+/// A diffuse vertex's sample of its BSDF by the cosine, as a wave draws it
+/// ([`CosineScatters`]): the direction, its weight `f |cos| / pdf`, and its pdf.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct DrawnScatter {
+    pub wi: Vec3,
+    pub weight: Vec3,
+    pub pdf: f32,
+}
+
+/// The inputs of a request in [`CosineScatters`], a row each: `u`, the albedo, `wo`, the
+/// normal.
+const SCATTER_INPUTS: usize = 11;
+/// The outputs of a request in [`CosineScatters`], a row each: `wi`, the weight, the
+/// pdf, and 1 where the sample carries weight (0 where it has none).
+const SCATTER_OUTPUTS: usize = 8;
+
+/// The samples by the cosine that a wave's Lambertian vertices scatter by, drawn
+/// together, a request per lane ([`CosineScatterLanes`]): each is the bits
+/// [`Material::sample`] and its weight give for it alone, whatever its company and the
+/// SIMD level. One is a chain of a sine and cosine, two square roots and two divisions
+/// that the vertex's shading would wait on; in lanes, a vector of them costs about what
+/// one does.
+///
+/// Requests and samples are kept in groups of [`MAX_LANES`], as rows of lanes: request
+/// `k` is lane `k % MAX_LANES` of group `k / MAX_LANES`, written and read with one bounds
+/// check and fixed offsets, and every level's vectors divide a group.
+#[derive(Debug, Default)]
+pub(crate) struct CosineScatters {
+    /// Per group, its requests' inputs, a row each.
+    inputs: Vec<[[f32; MAX_LANES]; SCATTER_INPUTS]>,
+    /// Per group, after [`CosineScatters::draw`]: its samples, a row each.
+    drawn: Vec<[[f32; MAX_LANES]; SCATTER_OUTPUTS]>,
+    /// How many requests there are.
+    len: usize,
+}
+
+impl CosineScatters {
+    /// Empties the batch for a wave of at most `capacity` requests.
+    pub fn clear(&mut self, capacity: usize) {
+        let groups = capacity.div_ceil(MAX_LANES);
+        self.inputs
+            .resize(groups, [[0.0; MAX_LANES]; SCATTER_INPUTS]);
+        self.len = 0;
+    }
+
+    /// Asks for the sample of `u` at a Lambertian vertex of `albedo` with normal `n`, seen
+    /// along `wo`; its index in the drawn samples.
+    ///
+    /// # Panics
+    /// Past the capacity given to [`CosineScatters::clear`].
+    #[inline(always)]
+    pub fn request(&mut self, u: Vec2, albedo: Vec3, wo: Vec3, n: Vec3) -> usize {
+        let k = self.len;
+        let values = [
+            u.x, u.y, albedo.x, albedo.y, albedo.z, wo.x, wo.y, wo.z, n.x, n.y, n.z,
+        ];
+        write_lane(&mut self.inputs[k / MAX_LANES], k % MAX_LANES, values);
+        self.len += 1;
+        k
+    }
+
+    /// Request `k`'s sample, after [`CosineScatters::draw`]; `None` where it carries no
+    /// weight.
+    #[inline(always)]
+    pub fn drawn(&self, k: usize) -> Option<DrawnScatter> {
+        debug_assert!(k < self.len);
+        let [wx, wy, wz, fx, fy, fz, pdf, valid] = &self.drawn[k / MAX_LANES];
+        let lane = k % MAX_LANES;
+        (valid[lane] != 0.0).then(|| DrawnScatter {
+            wi: Vec3::new(wx[lane], wy[lane], wz[lane]),
+            weight: Vec3::new(fx[lane], fy[lane], fz[lane]),
+            pdf: pdf[lane],
+        })
+    }
+
+    /// How many requests were drawn.
+    #[cfg(test)]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Draws every request's sample on `level` (the widest available where it is not).
+    /// The lanes past the last request hold what an earlier wave left there, or zeros:
+    /// finite, and never read.
+    pub fn draw(&mut self, level: SimdLevel) {
+        let groups = self.len.div_ceil(MAX_LANES);
+        self.drawn
+            .resize(groups, [[0.0; MAX_LANES]; SCATTER_OUTPUTS]);
+        // The level is available: `or_widest` says so.
+        let _ = level.or_widest().dispatch(DrawScatters {
+            inputs: &self.inputs[..groups],
+            drawn: &mut self.drawn,
+        });
+    }
+}
+
+/// The kernel of [`CosineScatters::draw`].
+struct DrawScatters<'a> {
+    inputs: &'a [[[f32; MAX_LANES]; SCATTER_INPUTS]],
+    drawn: &'a mut [[[f32; MAX_LANES]; SCATTER_OUTPUTS]],
+}
+
+impl LaneKernel for DrawScatters<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let DrawScatters { inputs, drawn } = self;
+        let width = L::LANES.min(MAX_LANES);
+        debug_assert_eq!(MAX_LANES % width, 0);
+        for (input, out) in inputs.iter().zip(drawn) {
+            for start in (0..MAX_LANES).step_by(width) {
+                let lanes = start..start + width;
+                // Not closures: they would be compiled apart from the kernel's features.
+                let mut rows = [L::splat(0.0); SCATTER_INPUTS];
+                for (lane, row) in rows.iter_mut().zip(input) {
+                    *lane = L::load(&row[lanes.clone()]);
+                }
+                let [u0, u1, ax, ay, az, ox, oy, oz, nx, ny, nz] = rows;
+                let local = sample_cosine_hemisphere_lanes([u0, u1]);
+                let s = CosineScatterLanes::new(
+                    LaneVec3::new(ax, ay, az),
+                    LaneVec3::new(ox, oy, oz),
+                    LaneVec3::new(nx, ny, nz),
+                    local,
+                );
+                let valid = L::select(s.valid, L::splat(1.0), L::splat(0.0));
+                let values = [
+                    s.wi.x, s.wi.y, s.wi.z, s.weight.x, s.weight.y, s.weight.z, s.pdf, valid,
+                ];
+                for (row, value) in out.iter_mut().zip(values) {
+                    value.store(&mut row[lanes.clone()]);
+                }
+            }
+        }
+    }
+}
+
 /// Whether `strategy` adds next-event estimation (a shadow ray toward a
 /// chosen emitter) at each diffuse vertex, besides the direction it
 /// scatters in; the weight of emission found along that direction then
@@ -349,17 +489,41 @@ pub(crate) fn hemisphere(
     v: &Vertex<'_>,
     hemisphere: HemisphereSampling,
     u: Vec2,
-    drawn: Option<Vec3>,
+    drawn: Option<Option<DrawnScatter>>,
 ) -> Option<Scatter> {
-    let s = v
-        .material
-        .sample_drawn(v.wo, v.at.n, u, hemisphere, drawn)?;
+    let s = bsdf_sample(v, hemisphere, u, drawn)?;
     Some(Scatter {
         wi: s.wi,
-        weight: s.weight(v.at.n),
+        weight: s.weight,
         pdf: s.pdf,
         emission: EmissionWeight::Full,
     })
+}
+
+/// The BSDF's sample of `u` at the vertex, and its weight: `drawn` where the wave drew it
+/// ([`CosineScatters`], the same bits), else drawn here.
+#[inline(always)]
+fn bsdf_sample(
+    v: &Vertex<'_>,
+    hemisphere: HemisphereSampling,
+    u: Vec2,
+    drawn: Option<Option<DrawnScatter>>,
+) -> Option<DrawnScatter> {
+    let alone = || {
+        let s = v.material.sample(v.wo, v.at.n, u, hemisphere)?;
+        Some(DrawnScatter {
+            wi: s.wi,
+            weight: s.weight(v.at.n),
+            pdf: s.pdf,
+        })
+    };
+    match drawn {
+        Some(drawn) => {
+            debug_assert_eq!(drawn, alone());
+            drawn
+        }
+        None => alone(),
+    }
 }
 
 /// `light`: a direction toward a chosen emitter only, with the pdf summed
@@ -416,16 +580,18 @@ pub(crate) fn mixture_pdf(emitters: &Emitters<'_>, v: &Vertex<'_>, wi: Vec3) -> 
 /// against next-event estimation ([`Lighting::next_event`] is the other
 /// half).
 ///
-/// Always inlined, as [`Material::sample_drawn`] is: out of line, its result comes back
-/// through memory, stored in pieces and loaded whole.
+/// Always inlined: out of line, its result comes back through memory, stored in pieces
+/// and loaded whole.
 #[inline(always)]
-pub(crate) fn mis_bsdf(v: &Vertex<'_>, u: Vec2, drawn: Option<Vec3>) -> Option<Scatter> {
-    let s = v
-        .material
-        .sample_drawn(v.wo, v.at.n, u, MIS_HEMISPHERE, drawn)?;
+pub(crate) fn mis_bsdf(
+    v: &Vertex<'_>,
+    u: Vec2,
+    drawn: Option<Option<DrawnScatter>>,
+) -> Option<Scatter> {
+    let s = bsdf_sample(v, MIS_HEMISPHERE, u, drawn)?;
     Some(Scatter {
         wi: s.wi,
-        weight: s.weight(v.at.n),
+        weight: s.weight,
         pdf: s.pdf,
         emission: EmissionWeight::PowerHeuristic { bsdf_pdf: s.pdf },
     })
@@ -674,6 +840,80 @@ mod tests {
                 for (&k, &u) in indices.iter().zip(&requests) {
                     let alone = lueur_sampling::sample_cosine_hemisphere(u);
                     assert_eq!(draws.drawn(k), alone, "{level:?}, {n} requests, u = {u}");
+                }
+            }
+        }
+    }
+
+    /// A wave's samples by the cosine, drawn in lanes, are the bits `Material::sample`
+    /// and its weight give for each alone (and `None` where that gives none), on every
+    /// SIMD level and for any number of requests: normals on both sides of `wo`, along
+    /// both poles (where the frame's construction changes sign), at the ends of the
+    /// square and its centre, and with a short last vector.
+    #[test]
+    fn cosine_scatters_are_each_sample_alone() {
+        let mut u = uniforms(13);
+        let mut unit = || {
+            let v = Vec3::new(2.0 * u() - 1.0, 2.0 * u() - 1.0, 2.0 * u() - 1.0);
+            v.try_normalize().unwrap_or(Vec3::Z)
+        };
+        let poles = [
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::new(1e-4, -2e-4, -1.0).normalize(),
+            Vec3::X,
+        ];
+        let ends = [0.0, 0.5, lueur_sampling::ONE_MINUS_EPSILON];
+        let mut requests = Vec::new();
+        for i in 0..53 {
+            let n = if i % 5 == 0 { poles[i % 4] } else { unit() };
+            let wo = unit();
+            let albedo = Vec3::new(0.73, 0.05 * (i % 3) as f32, 0.15);
+            requests.push((Vec2::new(ends[i % 3], ends[(i / 3) % 3]), albedo, wo, n));
+            let mut r = uniforms(i as u64);
+            requests.push((Vec2::new(r(), r()), albedo, -wo, n));
+        }
+        let none = (requests.iter())
+            .filter(|&&(u, albedo, wo, n)| {
+                let material = Material::Lambertian { albedo };
+                material
+                    .sample(wo, n, u, HemisphereSampling::Cosine)
+                    .is_none()
+            })
+            .count();
+        assert!(
+            (1..requests.len() / 2).contains(&none),
+            "{none} without a sample"
+        );
+        for level in SimdLevel::available() {
+            for count in [1, 7, 16, 17, requests.len()] {
+                let mut draws = CosineScatters::default();
+                // A wave before, whose requests stay in the lanes past this one's.
+                draws.clear(requests.len());
+                for &(u, albedo, wo, n) in requests.iter().rev() {
+                    draws.request(u, albedo, wo, n);
+                }
+                draws.draw(level);
+                draws.clear(count);
+                let indices: Vec<usize> = (requests[..count].iter())
+                    .map(|&(u, albedo, wo, n)| draws.request(u, albedo, wo, n))
+                    .collect();
+                draws.draw(level);
+                assert_eq!(draws.len(), count);
+                for (&k, &(u, albedo, wo, n)) in indices.iter().zip(&requests) {
+                    let material = Material::Lambertian { albedo };
+                    let alone = material
+                        .sample(wo, n, u, HemisphereSampling::Cosine)
+                        .map(|s| DrawnScatter {
+                            wi: s.wi,
+                            weight: s.weight(n),
+                            pdf: s.pdf,
+                        });
+                    assert_eq!(
+                        draws.drawn(k),
+                        alone,
+                        "{level:?}, {count} requests, u = {u}"
+                    );
                 }
             }
         }

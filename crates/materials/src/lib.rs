@@ -14,6 +14,9 @@
 //! given direction, since a direction chosen by anything else hits it with
 //! probability zero.
 //!
+//! [`CosineScatterLanes`] is the Lambertian's sample by the cosine for a vector of
+//! vertices at once, the one definition that [`Material::sample`] runs at one lane.
+//!
 //! This crate deliberately knows nothing of lights' geometry, scenes or rays:
 //! light sampling lives in `lueur-sampling` and the estimators that combine
 //! both live in `lueur-integrator`.
@@ -35,9 +38,10 @@
 
 use glam::{Vec2, Vec3};
 use lueur_sampling::{
-    Frame, cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere,
-    uniform_hemisphere_pdf,
+    Frame, FrameLanes, cosine_hemisphere_pdf, cosine_hemisphere_pdf_lanes,
+    sample_cosine_hemisphere, sample_uniform_hemisphere, uniform_hemisphere_pdf,
 };
+use lueur_sdf_math::{Lane, LaneVec3};
 use std::f32::consts::FRAC_1_PI;
 
 /// How a diffuse lobe picks its directions: the integrator's strategy
@@ -85,9 +89,72 @@ impl BsdfSample {
         if self.is_delta {
             self.f
         } else {
-            self.f * n.dot(self.wi).abs() / self.pdf
+            weight_lanes(self.f.into(), n.into(), self.wi.into(), self.pdf).into()
         }
     }
+}
+
+/// [`BsdfSample::weight`] of a lobe that is not a delta, per lane: its one definition.
+#[inline(always)]
+fn weight_lanes<L: Lane>(f: LaneVec3<L>, n: LaneVec3<L>, wi: LaneVec3<L>, pdf: L) -> LaneVec3<L> {
+    f * n.dot(wi).abs() / pdf
+}
+
+/// A Lambertian surface's direction sampled by the cosine, per lane:
+/// [`Material::sample`] with [`HemisphereSampling::Cosine`] and then
+/// [`BsdfSample::weight`], given the local direction drawn from the lane's numbers
+/// ([`lueur_sampling::sample_cosine_hemisphere_lanes`]). The one definition of that
+/// sample: the scalar method is this at `f32`, so a batch of vertices gets each vertex's
+/// bits.
+#[derive(Clone, Copy, Debug)]
+pub struct CosineScatterLanes<L: Lane> {
+    /// The direction in the world frame.
+    pub wi: LaneVec3<L>,
+    /// Its solid-angle pdf.
+    pub pdf: L,
+    /// The throughput factor `f |cos| / pdf`.
+    pub weight: LaneVec3<L>,
+    /// Where the sample carries weight; elsewhere the other fields mean nothing.
+    pub valid: L::Mask,
+}
+
+impl<L: Lane> CosineScatterLanes<L> {
+    /// The sample of a Lambertian surface of `albedo` with normal `n`, seen along `wo`,
+    /// whose cosine-weighted local direction is `local`.
+    #[inline(always)]
+    pub fn new(
+        albedo: LaneVec3<L>,
+        wo: LaneVec3<L>,
+        n: LaneVec3<L>,
+        local: LaneVec3<L>,
+    ) -> CosineScatterLanes<L> {
+        let zero = L::splat(0.0);
+        let pdf = cosine_hemisphere_pdf_lanes(local.z);
+        let valid = L::and(pdf.gt(zero), local.z.gt(zero));
+        let n = two_sided_lanes(n, wo);
+        // Unit to within a few ulps (an orthonormal frame and a unit `local`), without the
+        // square root and division the next ray waits on.
+        let wi = FrameLanes::from_normal(n).to_world(local);
+        let f = albedo * L::splat(FRAC_1_PI);
+        CosineScatterLanes {
+            wi,
+            pdf,
+            weight: weight_lanes(f, n, wi, pdf),
+            valid,
+        }
+    }
+}
+
+/// The normal on the side `wo` is on, per lane: surfaces are two-sided.
+#[inline(always)]
+fn two_sided_lanes<L: Lane>(n: LaneVec3<L>, wo: LaneVec3<L>) -> LaneVec3<L> {
+    let behind = n.dot(wo).lt(L::splat(0.0));
+    let flipped = -n;
+    LaneVec3::new(
+        L::select(behind, flipped.x, n.x),
+        L::select(behind, flipped.y, n.y),
+        L::select(behind, flipped.z, n.z),
+    )
 }
 
 impl Material {
@@ -136,55 +203,39 @@ impl Material {
         u: Vec2,
         hemisphere: HemisphereSampling,
     ) -> Option<BsdfSample> {
-        self.sample_drawn(wo, n, u, hemisphere, None)
-    }
-
-    /// [`Material::sample`], where the cosine-weighted local direction was `drawn`
-    /// already from `u` (`sample_cosine_hemisphere(u)`, or its lanes form for a batch
-    /// of vertices); used only by [`HemisphereSampling::Cosine`] on a diffuse lobe.
-    /// Always inlined: out of line, its vectors pass through memory, stored in pieces
-    /// and loaded whole, and each load waits for its stores to retire.
-    #[inline(always)]
-    pub fn sample_drawn(
-        &self,
-        wo: Vec3,
-        n: Vec3,
-        u: Vec2,
-        hemisphere: HemisphereSampling,
-        drawn: Option<Vec3>,
-    ) -> Option<BsdfSample> {
-        // Scatter on the side `wo` is on: surfaces are two-sided.
-        let n = if n.dot(wo) < 0.0 { -n } else { n };
         match *self {
-            Material::Lambertian { albedo } => {
-                let local = match hemisphere {
-                    HemisphereSampling::Uniform => sample_uniform_hemisphere(u),
-                    HemisphereSampling::Cosine => match drawn {
-                        Some(local) => {
-                            debug_assert_eq!(local, sample_cosine_hemisphere(u));
-                            local
-                        }
-                        None => sample_cosine_hemisphere(u),
-                    },
-                };
-                let pdf = match hemisphere {
-                    HemisphereSampling::Uniform => uniform_hemisphere_pdf(),
-                    HemisphereSampling::Cosine => cosine_hemisphere_pdf(local.z),
-                };
-                if !(pdf > 0.0) || local.z <= 0.0 {
-                    return None;
+            Material::Lambertian { albedo } => match hemisphere {
+                HemisphereSampling::Uniform => {
+                    let n: Vec3 = two_sided_lanes(n.into(), wo.into()).into();
+                    let local = sample_uniform_hemisphere(u);
+                    let pdf = uniform_hemisphere_pdf();
+                    if !(pdf > 0.0) || local.z <= 0.0 {
+                        return None;
+                    }
+                    // Unit to within a few ulps (an orthonormal frame and a unit `local`),
+                    // without the square root and division the next ray waits on.
+                    let wi = Frame::from_normal(n).to_world(local);
+                    Some(BsdfSample {
+                        wi,
+                        f: albedo * FRAC_1_PI,
+                        pdf,
+                        is_delta: false,
+                    })
                 }
-                // Unit to within a few ulps (an orthonormal frame and a unit `local`),
-                // without the square root and division the next ray waits on.
-                let wi = Frame::from_normal(n).to_world(local);
-                Some(BsdfSample {
-                    wi,
-                    f: albedo * FRAC_1_PI,
-                    pdf,
-                    is_delta: false,
-                })
-            }
+                HemisphereSampling::Cosine => {
+                    let local = sample_cosine_hemisphere(u);
+                    let s =
+                        CosineScatterLanes::new(albedo.into(), wo.into(), n.into(), local.into());
+                    s.valid.then(|| BsdfSample {
+                        wi: s.wi.into(),
+                        f: albedo * FRAC_1_PI,
+                        pdf: s.pdf,
+                        is_delta: false,
+                    })
+                }
+            },
             Material::Mirror { reflectance } => {
+                let n: Vec3 = two_sided_lanes(n.into(), wo.into()).into();
                 let wi = reflect(wo, n);
                 Some(BsdfSample {
                     wi,

@@ -52,9 +52,12 @@ impl Frame {
 /// [`Frame`] for a normal per lane: the one definition of the construction, whose
 /// one-lane instance [`Frame::from_normal`] is.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct FrameLanes<L> {
+pub struct FrameLanes<L> {
+    /// First tangent (local `+x`).
     pub s: LaneVec3<L>,
+    /// Second tangent (local `+y`).
     pub t: LaneVec3<L>,
+    /// Normal (local `+z`).
     pub n: LaneVec3<L>,
 }
 

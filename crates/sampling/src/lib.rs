@@ -85,7 +85,7 @@ mod warp;
 pub use glam::{Vec2, Vec3};
 
 pub use discrete::DiscreteDistribution;
-pub use frame::Frame;
+pub use frame::{Frame, FrameLanes};
 pub use light::{DirectionSample, DirectionSampleLanes};
 pub use math::ONE_MINUS_EPSILON;
 pub use mis::{balance_heuristic, power_heuristic};
@@ -99,9 +99,10 @@ pub use sphere_light::{
     sample_sphere_light, sample_sphere_light_lanes, sphere_light_pdf, sphere_solid_angle,
 };
 pub use warp::{
-    cosine_hemisphere_pdf, invert_cosine_hemisphere, invert_uniform_cone,
-    invert_uniform_disk_concentric, invert_uniform_hemisphere, invert_uniform_sphere,
-    sample_cosine_hemisphere, sample_cosine_hemisphere_lanes, sample_uniform_cone,
-    sample_uniform_disk_concentric, sample_uniform_hemisphere, sample_uniform_sphere,
-    uniform_cone_pdf, uniform_disk_pdf, uniform_hemisphere_pdf, uniform_sphere_pdf,
+    cosine_hemisphere_pdf, cosine_hemisphere_pdf_lanes, invert_cosine_hemisphere,
+    invert_uniform_cone, invert_uniform_disk_concentric, invert_uniform_hemisphere,
+    invert_uniform_sphere, sample_cosine_hemisphere, sample_cosine_hemisphere_lanes,
+    sample_uniform_cone, sample_uniform_disk_concentric, sample_uniform_hemisphere,
+    sample_uniform_sphere, uniform_cone_pdf, uniform_disk_pdf, uniform_hemisphere_pdf,
+    uniform_sphere_pdf,
 };

@@ -130,7 +130,13 @@ pub fn sample_cosine_hemisphere_lanes<L: Lane>(u: [L; 2]) -> LaneVec3<L> {
 /// Solid-angle pdf of [`sample_cosine_hemisphere`]: `max(cos_theta, 0) / pi`
 /// (pbrt-v4 §A.5.3). NaN input gives 0.
 pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
-    cos_theta.max(0.0) * FRAC_1_PI
+    cosine_hemisphere_pdf_lanes(cos_theta)
+}
+
+/// [`cosine_hemisphere_pdf`] per lane, its one definition.
+#[inline(always)]
+pub fn cosine_hemisphere_pdf_lanes<L: Lane>(cos_theta: L) -> L {
+    cos_theta.max(L::splat(0.0)) * L::splat(FRAC_1_PI)
 }
 
 /// Inverse of [`sample_cosine_hemisphere`]: the concentric inverse of the
