@@ -9,7 +9,7 @@ use lueur_sampling::{
     SphericalRectangles, cosine_hemisphere_pdf, sample_cosine_hemisphere,
     sample_sphere_light_lanes,
 };
-use lueur_sdf_math::{Lane, LaneKernel, LaneVec3, MAX_LANES, SimdLevel, fill_lane_groups};
+use lueur_sdf_math::{Lane, LaneKernel, LaneVec3, MAX_LANES, SimdLevel, write_lane};
 
 use lueur_scene::{EmitterSample, Light, QuadSampling};
 
@@ -334,19 +334,24 @@ impl RectangleDraws {
 /// [`lueur_sampling::sample_sphere_light`] gives for it, whatever its company and the
 /// SIMD level. One sample is a chain of dependent square roots and divisions; in lanes,
 /// a vector of them costs about what one does.
+///
+/// Requests are kept in groups of [`MAX_LANES`], as rows of lanes: request `k` is lane
+/// `k % MAX_LANES` of group `k / MAX_LANES`, written as it is asked for, and every level's
+/// vectors divide a group. Lanes past the last request hold an earlier wave's, or zeros,
+/// and are never read.
 #[derive(Debug, Default)]
 pub(crate) struct SphereDraws {
-    /// Per request: the shading point, the sphere's centre and radius, `u`.
-    requests: Vec<[f32; 9]>,
-    /// While drawing, the requests as rows of lanes, a group per vector.
+    /// Per group: the shading point, the sphere's centre and radius, `u` of each request.
     rows: Vec<[[f32; MAX_LANES]; 9]>,
+    /// How many requests there are.
+    len: usize,
     /// Per request, after [`SphereDraws::draw`]: its sample.
     pub drawn: Vec<Option<DirectionSample>>,
 }
 
 impl SphereDraws {
     pub fn clear(&mut self) {
-        self.requests.clear();
+        self.len = 0;
         self.drawn.clear();
     }
 
@@ -355,22 +360,32 @@ impl SphereDraws {
     /// and loaded whole, and each load waits for its stores to retire.
     #[inline(always)]
     pub fn request(&mut self, p: Vec3, (center, radius): (Vec3, f32), u: Vec2) -> usize {
-        self.requests.push([
-            p.x, p.y, p.z, center.x, center.y, center.z, radius, u.x, u.y,
-        ]);
-        self.requests.len() - 1
+        let k = self.len;
+        let group = k / MAX_LANES;
+        if group == self.rows.len() {
+            self.rows.push([[0.0; MAX_LANES]; 9]);
+        }
+        write_lane(
+            &mut self.rows[group],
+            k % MAX_LANES,
+            [
+                p.x, p.y, p.z, center.x, center.y, center.z, radius, u.x, u.y,
+            ],
+        );
+        self.len += 1;
+        k
     }
 
     /// Draws every request's sample on `level` (the widest available where it is not).
     pub fn draw(&mut self, level: SimdLevel) {
         self.drawn.clear();
-        if self.requests.is_empty() {
+        if self.len == 0 {
             return;
         }
         // The level is available: `or_widest` says so.
         let _ = level.or_widest().dispatch(DrawSpheres {
-            requests: &self.requests,
-            rows: &mut self.rows,
+            rows: &self.rows[..self.len.div_ceil(MAX_LANES)],
+            len: self.len,
             drawn: &mut self.drawn,
         });
     }
@@ -378,8 +393,8 @@ impl SphereDraws {
 
 /// The kernel of [`SphereDraws::draw`].
 struct DrawSpheres<'a> {
-    requests: &'a [[f32; 9]],
-    rows: &'a mut Vec<[[f32; MAX_LANES]; 9]>,
+    rows: &'a [[[f32; MAX_LANES]; 9]],
+    len: usize,
     drawn: &'a mut Vec<Option<DirectionSample>>,
 }
 
@@ -388,23 +403,22 @@ impl LaneKernel for DrawSpheres<'_> {
 
     #[inline(always)]
     fn run<L: Lane>(self) {
-        let DrawSpheres {
-            requests,
-            rows,
-            drawn,
-        } = self;
-        let n = requests.len();
-        // Whole rows in and out, whatever the group's size: a load or store of a length
-        // not known when compiling is a call to `memcpy`. Every group's rows are written
-        // first ([`fill_lane_groups`] says why); lanes past a short last group are not
-        // read back.
+        let DrawSpheres { rows, len, drawn } = self;
         let width = L::LANES.min(MAX_LANES);
-        fill_lane_groups(requests.iter().copied(), width, rows);
-        for (g, group) in rows.iter().enumerate() {
-            let (start, end) = (g * width, ((g + 1) * width).min(n));
+        debug_assert_eq!(MAX_LANES % width, 0);
+        let vectors = rows.iter().flat_map(|group| {
+            (0..MAX_LANES)
+                .step_by(width)
+                .map(move |first| (group, first))
+        });
+        for (v, (group, first)) in vectors.enumerate() {
+            let (start, end) = (v * width, ((v + 1) * width).min(len));
+            if start >= end {
+                break;
+            }
             let mut lanes = [L::splat(0.0); 9];
             for (lane, row) in lanes.iter_mut().zip(group) {
-                *lane = L::load(&row[..width]);
+                *lane = L::load(&row[first..first + width]);
             }
             let [px, py, pz, cx, cy, cz, radius, u0, u1] = lanes;
             let (p, center) = (LaneVec3::new(px, py, pz), LaneVec3::new(cx, cy, cz));

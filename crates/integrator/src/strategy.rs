@@ -702,7 +702,7 @@ mod tests {
     //! normal (`lueur_stats::DirectionBins`), after checking that the pdf
     //! each sample reports is the strategy's pdf at its direction.
     use super::*;
-    use crate::light_sampler::RectangleDraws;
+    use crate::light_sampler::{RectangleDraws, SphereDraws};
     use lueur_scene::{Camera, Light, QuadSampling, Scene};
     use lueur_stats::DirectionBins;
 
@@ -840,6 +840,56 @@ mod tests {
                 for (&k, &u) in indices.iter().zip(&requests) {
                     let alone = lueur_sampling::sample_cosine_hemisphere(u);
                     assert_eq!(draws.drawn(k), alone, "{level:?}, {n} requests, u = {u}");
+                }
+            }
+        }
+    }
+
+    /// A wave's sphere-light samples, drawn in lanes, are the bits
+    /// `sample_sphere_light` gives for each alone (and `None` where it gives none), on
+    /// every SIMD level and for any number of requests, after a wave whose requests stay
+    /// in the lanes past this one's: points outside the spheres, inside them, at their
+    /// centres and far away, at the ends of the square.
+    #[test]
+    fn sphere_draws_are_each_sample_alone() {
+        let mut u = uniforms(17);
+        let ends = [0.0, 0.5, lueur_sampling::ONE_MINUS_EPSILON];
+        let mut requests = Vec::new();
+        for i in 0..61 {
+            let center = Vec3::new(u() - 0.5, 1.0 + u(), u() - 0.5);
+            let radius = 0.05 + 0.3 * u();
+            let p = match i % 4 {
+                0 => center + Vec3::new(0.3, -0.2, 0.1) * radius,
+                1 => center,
+                2 => Vec3::new(1e3, -2e3, 5e2),
+                _ => Vec3::new(2.0 * u() - 1.0, 2.0 * u(), 2.0 * u() - 1.0),
+            };
+            let e = if i % 7 == 0 {
+                Vec2::new(ends[i % 3], ends[(i / 3) % 3])
+            } else {
+                Vec2::new(u(), u())
+            };
+            requests.push((p, (center, radius), e));
+        }
+        for level in SimdLevel::available() {
+            for count in [1, 7, 16, 17, requests.len()] {
+                let mut draws = SphereDraws::default();
+                for &(p, sphere, e) in requests.iter().rev() {
+                    draws.request(p, sphere, e);
+                }
+                draws.draw(level);
+                draws.clear();
+                let indices: Vec<usize> = (requests[..count].iter())
+                    .map(|&(p, sphere, e)| draws.request(p, sphere, e))
+                    .collect();
+                draws.draw(level);
+                assert_eq!(draws.drawn.len(), count);
+                for (&k, &(p, (center, radius), e)) in indices.iter().zip(&requests) {
+                    let alone = lueur_sampling::sample_sphere_light(p, center, radius, e);
+                    assert_eq!(
+                        draws.drawn[k], alone,
+                        "{level:?}, {count} requests, p = {p}"
+                    );
                 }
             }
         }
