@@ -9,7 +9,7 @@ use lueur_sampling::{
     SphericalRectangles, cosine_hemisphere_pdf, sample_cosine_hemisphere,
     sample_sphere_light_lanes,
 };
-use lueur_sdf_math::{Lane, LaneKernel, LaneVec3, MAX_LANES, SimdLevel, write_lane};
+use lueur_sdf_math::{Lane, LaneGroups, LaneKernel, LaneVec3, MAX_LANES, SimdLevel};
 
 use lueur_scene::{EmitterSample, Light, QuadSampling};
 
@@ -334,24 +334,17 @@ impl RectangleDraws {
 /// [`lueur_sampling::sample_sphere_light`] gives for it, whatever its company and the
 /// SIMD level. One sample is a chain of dependent square roots and divisions; in lanes,
 /// a vector of them costs about what one does.
-///
-/// Requests are kept in groups of [`MAX_LANES`], as rows of lanes: request `k` is lane
-/// `k % MAX_LANES` of group `k / MAX_LANES`, written as it is asked for, and every level's
-/// vectors divide a group. Lanes past the last request hold an earlier wave's, or zeros,
-/// and are never read.
 #[derive(Debug, Default)]
 pub(crate) struct SphereDraws {
-    /// Per group: the shading point, the sphere's centre and radius, `u` of each request.
-    rows: Vec<[[f32; MAX_LANES]; 9]>,
-    /// How many requests there are.
-    len: usize,
+    /// Per request: the shading point, the sphere's centre and radius, `u`.
+    requests: LaneGroups<9>,
     /// Per request, after [`SphereDraws::draw`]: its sample.
     pub drawn: Vec<Option<DirectionSample>>,
 }
 
 impl SphereDraws {
     pub fn clear(&mut self) {
-        self.len = 0;
+        self.requests.clear();
         self.drawn.clear();
     }
 
@@ -360,32 +353,21 @@ impl SphereDraws {
     /// and loaded whole, and each load waits for its stores to retire.
     #[inline(always)]
     pub fn request(&mut self, p: Vec3, (center, radius): (Vec3, f32), u: Vec2) -> usize {
-        let k = self.len;
-        let group = k / MAX_LANES;
-        if group == self.rows.len() {
-            self.rows.push([[0.0; MAX_LANES]; 9]);
-        }
-        write_lane(
-            &mut self.rows[group],
-            k % MAX_LANES,
-            [
-                p.x, p.y, p.z, center.x, center.y, center.z, radius, u.x, u.y,
-            ],
-        );
-        self.len += 1;
-        k
+        (self.requests).push([
+            p.x, p.y, p.z, center.x, center.y, center.z, radius, u.x, u.y,
+        ])
     }
 
     /// Draws every request's sample on `level` (the widest available where it is not).
     pub fn draw(&mut self, level: SimdLevel) {
         self.drawn.clear();
-        if self.len == 0 {
+        if self.requests.is_empty() {
             return;
         }
         // The level is available: `or_widest` says so.
         let _ = level.or_widest().dispatch(DrawSpheres {
-            rows: &self.rows[..self.len.div_ceil(MAX_LANES)],
-            len: self.len,
+            rows: self.requests.groups(),
+            len: self.requests.len(),
             drawn: &mut self.drawn,
         });
     }

@@ -422,7 +422,7 @@ pub(crate) fn radiance_wave(
         s.pending.clear();
         s.lights.clear();
         s.cosines.clear();
-        s.scatters.clear(s.active.len());
+        s.scatters.clear();
         let mut surfaces = s.surfaces.iter();
         for (&i, &hit) in s.active.iter().zip(&s.hits) {
             let path = &mut s.paths[i];

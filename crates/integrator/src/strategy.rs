@@ -10,7 +10,7 @@ use glam::{Vec2, Vec3};
 use lueur_materials::{CosineScatterLanes, HemisphereSampling, Material};
 use lueur_sampling::{Sampler, power_heuristic, sample_cosine_hemisphere_lanes};
 use lueur_sdf_math::{
-    Lane, LaneKernel, LaneVec3, MAX_LANES, Ray, SimdLevel, TraceParams, write_lane,
+    Lane, LaneGroups, LaneKernel, LaneVec3, MAX_LANES, Ray, SimdLevel, TraceParams,
 };
 
 use crate::light_sampler::{Drawn, Emitters};
@@ -355,51 +355,35 @@ const SCATTER_OUTPUTS: usize = 8;
 /// [`Material::sample`] and its weight give for it alone, whatever its company and the
 /// SIMD level. One is a chain of a sine and cosine, two square roots and two divisions
 /// that the vertex's shading would wait on; in lanes, a vector of them costs about what
-/// one does.
-///
-/// Requests and samples are kept in groups of [`MAX_LANES`], as rows of lanes: request
-/// `k` is lane `k % MAX_LANES` of group `k / MAX_LANES`, written and read with one bounds
-/// check and fixed offsets, and every level's vectors divide a group.
+/// one does. The samples are kept as the requests are ([`LaneGroups`]): request `k`'s is
+/// lane `k % MAX_LANES` of group `k / MAX_LANES`.
 #[derive(Debug, Default)]
 pub(crate) struct CosineScatters {
-    /// Per group, its requests' inputs, a row each.
-    inputs: Vec<[[f32; MAX_LANES]; SCATTER_INPUTS]>,
-    /// Per group, after [`CosineScatters::draw`]: its samples, a row each.
+    /// Per request, its inputs.
+    inputs: LaneGroups<SCATTER_INPUTS>,
+    /// Per group of requests, after [`CosineScatters::draw`]: their samples, a row each.
     drawn: Vec<[[f32; MAX_LANES]; SCATTER_OUTPUTS]>,
-    /// How many requests there are.
-    len: usize,
 }
 
 impl CosineScatters {
-    /// Empties the batch for a wave of at most `capacity` requests.
-    pub fn clear(&mut self, capacity: usize) {
-        let groups = capacity.div_ceil(MAX_LANES);
-        self.inputs
-            .resize(groups, [[0.0; MAX_LANES]; SCATTER_INPUTS]);
-        self.len = 0;
+    pub fn clear(&mut self) {
+        self.inputs.clear();
     }
 
     /// Asks for the sample of `u` at a Lambertian vertex of `albedo` with normal `n`, seen
     /// along `wo`; its index in the drawn samples.
-    ///
-    /// # Panics
-    /// Past the capacity given to [`CosineScatters::clear`].
     #[inline(always)]
     pub fn request(&mut self, u: Vec2, albedo: Vec3, wo: Vec3, n: Vec3) -> usize {
-        let k = self.len;
-        let values = [
+        self.inputs.push([
             u.x, u.y, albedo.x, albedo.y, albedo.z, wo.x, wo.y, wo.z, n.x, n.y, n.z,
-        ];
-        write_lane(&mut self.inputs[k / MAX_LANES], k % MAX_LANES, values);
-        self.len += 1;
-        k
+        ])
     }
 
     /// Request `k`'s sample, after [`CosineScatters::draw`]; `None` where it carries no
     /// weight.
     #[inline(always)]
     pub fn drawn(&self, k: usize) -> Option<DrawnScatter> {
-        debug_assert!(k < self.len);
+        debug_assert!(k < self.inputs.len());
         let [wx, wy, wz, fx, fy, fz, pdf, valid] = &self.drawn[k / MAX_LANES];
         let lane = k % MAX_LANES;
         (valid[lane] != 0.0).then(|| DrawnScatter {
@@ -412,19 +396,17 @@ impl CosineScatters {
     /// How many requests were drawn.
     #[cfg(test)]
     pub fn len(&self) -> usize {
-        self.len
+        self.inputs.len()
     }
 
     /// Draws every request's sample on `level` (the widest available where it is not).
-    /// The lanes past the last request hold what an earlier wave left there, or zeros:
-    /// finite, and never read.
     pub fn draw(&mut self, level: SimdLevel) {
-        let groups = self.len.div_ceil(MAX_LANES);
+        let inputs = self.inputs.groups();
         self.drawn
-            .resize(groups, [[0.0; MAX_LANES]; SCATTER_OUTPUTS]);
+            .resize(inputs.len(), [[0.0; MAX_LANES]; SCATTER_OUTPUTS]);
         // The level is available: `or_widest` says so.
         let _ = level.or_widest().dispatch(DrawScatters {
-            inputs: &self.inputs[..groups],
+            inputs,
             drawn: &mut self.drawn,
         });
     }
@@ -939,12 +921,11 @@ mod tests {
             for count in [1, 7, 16, 17, requests.len()] {
                 let mut draws = CosineScatters::default();
                 // A wave before, whose requests stay in the lanes past this one's.
-                draws.clear(requests.len());
                 for &(u, albedo, wo, n) in requests.iter().rev() {
                     draws.request(u, albedo, wo, n);
                 }
                 draws.draw(level);
-                draws.clear(count);
+                draws.clear();
                 let indices: Vec<usize> = (requests[..count].iter())
                     .map(|&(u, albedo, wo, n)| draws.request(u, albedo, wo, n))
                     .collect();

@@ -78,7 +78,7 @@ pub use crate::primitives::Primitive;
 pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
 pub use crate::stream::{
-    MAX_LANES, StreamField, fill_lane_groups, sphere_trace_relaxed_stream,
+    LaneGroups, MAX_LANES, StreamField, fill_lane_groups, sphere_trace_relaxed_stream,
     sphere_trace_relaxed_stream_at, sphere_trace_relaxed_stream_of, sphere_trace_stream,
     sphere_trace_stream_at, write_lane,
 };

@@ -81,6 +81,53 @@ pub fn fill_lane_groups<const R: usize>(
     }
 }
 
+/// Records of `R` numbers kept for a kernel that loads them a vector at a time, in groups
+/// of [`MAX_LANES`] lanes as rows: record `k` is lane `k % MAX_LANES` of group
+/// `k / MAX_LANES`. Each is written in place as it is pushed (one bounds check, fixed
+/// offsets, no per-row length), long before the kernel loads it, and every level's
+/// vectors divide a group. Lanes past the last record hold earlier records, or zeros:
+/// finite, for the kernel to ignore.
+#[derive(Clone, Debug, Default)]
+pub struct LaneGroups<const R: usize> {
+    groups: Vec<[[f32; MAX_LANES]; R]>,
+    len: usize,
+}
+
+impl<const R: usize> LaneGroups<R> {
+    /// Forgets every record (keeping the memory).
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    /// Adds a record; its index.
+    #[inline(always)]
+    pub fn push(&mut self, values: [f32; R]) -> usize {
+        let k = self.len;
+        let group = k / MAX_LANES;
+        if group == self.groups.len() {
+            self.groups.push([[0.0; MAX_LANES]; R]);
+        }
+        write_lane(&mut self.groups[group], k % MAX_LANES, values);
+        self.len += 1;
+        k
+    }
+
+    /// How many records there are.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The groups that hold the records, the last one partly past them.
+    pub fn groups(&self) -> &[[[f32; MAX_LANES]; R]] {
+        &self.groups[..self.len.div_ceil(MAX_LANES)]
+    }
+}
+
 /// One field for every ray of a stream.
 struct Shared<'a, F: ?Sized>(&'a F);
 
@@ -450,6 +497,31 @@ impl<F: StreamField> LaneKernel for RelaxedStream<'_, F> {
 #[cfg(test)]
 mod tests {
     use glam::{Quat, Vec3};
+
+    /// Record `k` is lane `k % MAX_LANES` of group `k / MAX_LANES`; the groups cover the
+    /// records and no more, and a cleared set refills from the first lane.
+    #[test]
+    fn lane_groups_hold_record_k_in_its_lane() {
+        let mut records = LaneGroups::<2>::default();
+        for round in 0..2 {
+            records.clear();
+            let n = if round == 0 { 37 } else { 5 };
+            for k in 0..n {
+                assert_eq!(records.push([k as f32, -(k as f32) - round as f32]), k);
+            }
+            assert_eq!(records.len(), n);
+            assert_eq!(records.groups().len(), n.div_ceil(MAX_LANES));
+            for k in 0..n {
+                let [a, b] = &records.groups()[k / MAX_LANES];
+                assert_eq!(
+                    (a[k % MAX_LANES], b[k % MAX_LANES]),
+                    (k as f32, -(k as f32) - round as f32)
+                );
+            }
+        }
+        records.clear();
+        assert!(records.is_empty() && records.groups().is_empty());
+    }
 
     use super::*;
     use crate::{OVER_RELAXATION, PreparedSdf, Sdf, sphere_trace, sphere_trace_relaxed};
