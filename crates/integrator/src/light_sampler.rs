@@ -353,7 +353,7 @@ impl SphereDraws {
     /// and loaded whole, and each load waits for its stores to retire.
     #[inline(always)]
     pub fn request(&mut self, p: Vec3, (center, radius): (Vec3, f32), u: Vec2) -> usize {
-        (self.requests).push([
+        self.requests.push([
             p.x, p.y, p.z, center.x, center.y, center.z, radius, u.x, u.y,
         ])
     }

@@ -232,8 +232,8 @@ pub(crate) fn scatters_by_cosine(strategy: Strategy) -> bool {
     }
 }
 
-/// The cosine-weighted local directions a wave's diffuse vertices scatter by, drawn
-/// together, a request per lane ([`sample_cosine_hemisphere_lanes`]): each is the bits
+/// The cosine-weighted local directions of a wave's next-event estimation toward the sky,
+/// drawn together, a request per lane ([`sample_cosine_hemisphere_lanes`]): each is the bits
 /// `sample_cosine_hemisphere` gives for its numbers alone, whatever its company and the
 /// SIMD level. One is a chain of a division, a sine and cosine, and a square root, which
 /// the shading of its vertex would wait on; in lanes, a vector of them costs about what
@@ -353,8 +353,8 @@ const SCATTER_OUTPUTS: usize = 8;
 /// The samples by the cosine that a wave's Lambertian vertices scatter by, drawn
 /// together, a request per lane ([`CosineScatterLanes`]): each is the bits
 /// [`Material::sample`] and its weight give for it alone, whatever its company and the
-/// SIMD level. One is a chain of a sine and cosine, two square roots and two divisions
-/// that the vertex's shading would wait on; in lanes, a vector of them costs about what
+/// SIMD level. One is a chain of a sine and cosine, a square root and two divisions that
+/// the vertex's shading would wait on; in lanes, a vector of them costs about what
 /// one does. The samples are kept as the requests are ([`LaneGroups`]): request `k`'s is
 /// lane `k % MAX_LANES` of group `k / MAX_LANES`.
 #[derive(Debug, Default)]
