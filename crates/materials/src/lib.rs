@@ -112,6 +112,8 @@ pub struct CosineScatterLanes<L: Lane> {
     pub wi: LaneVec3<L>,
     /// Its solid-angle pdf.
     pub pdf: L,
+    /// The BSDF's value `albedo / pi`.
+    pub f: LaneVec3<L>,
     /// The throughput factor `f |cos| / pdf`.
     pub weight: LaneVec3<L>,
     /// Where the sample carries weight; elsewhere the other fields mean nothing.
@@ -139,6 +141,7 @@ impl<L: Lane> CosineScatterLanes<L> {
         CosineScatterLanes {
             wi,
             pdf,
+            f,
             weight: weight_lanes(f, n, wi, pdf),
             valid,
         }
@@ -228,7 +231,7 @@ impl Material {
                         CosineScatterLanes::new(albedo.into(), wo.into(), n.into(), local.into());
                     s.valid.then(|| BsdfSample {
                         wi: s.wi.into(),
-                        f: albedo * FRAC_1_PI,
+                        f: s.f.into(),
                         pdf: s.pdf,
                         is_delta: false,
                     })
