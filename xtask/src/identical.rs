@@ -17,7 +17,7 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use exr::prelude::{FlatSamples, read_all_flat_layers_from_file};
 
-use crate::memory::build_lueur;
+use crate::memory::{Build, build_lueur};
 use crate::old;
 use crate::reference::cache_dir;
 use crate::{run_lueur, shipped_scenes};
@@ -30,7 +30,7 @@ const STRATEGIES: [&str; 2] = ["mis", "mixture"];
 const SAMPLERS: [Option<&str>; 2] = [None, Some("independent")];
 
 pub fn run(old_path: Option<&Path>, old_rev: Option<&str>) -> Result<()> {
-    let Some(old) = old::resolve(old_path, old_rev)? else {
+    let Some(old) = old::resolve(old_path, old_rev, Build::Release)? else {
         bail!("name the other build: --old PATH or --old-rev REV");
     };
     let new = build_lueur()?;

@@ -36,7 +36,7 @@ use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 
-use crate::memory::build_lueur;
+use crate::memory::{Build, build_lueur};
 use crate::old::{self, Old};
 use crate::reference::cache_dir;
 use crate::report::{Plans, quick_flag, write_report};
@@ -103,7 +103,7 @@ struct Counted {
 pub fn run(quick: bool, old_path: Option<&Path>, old_rev: Option<&str>) -> Result<()> {
     let plan = PLANS.pick(quick);
     let valgrind = valgrind_version()?;
-    let old = old::resolve(old_path, old_rev)?;
+    let old = old::resolve(old_path, old_rev, Build::Release)?;
     let new = build_lueur()?;
     let work = cache_dir()?.join("instructions");
     std::fs::create_dir_all(&work).with_context(|| format!("creating {}", work.display()))?;

@@ -120,6 +120,11 @@ enum Command {
         /// target/xtask/old/), so the report can be rerun from a clean clone.
         #[arg(long, value_name = "REV", conflicts_with = "old")]
         old_rev: Option<String>,
+        /// How lueur is built: `release` (what the README's render command
+        /// runs) or `dist` (what `cargo install --profile dist` installs: LTO);
+        /// an `--old-rev` commit is built the same way.
+        #[arg(long, value_enum, default_value = "release")]
+        profile: memory::Build,
     },
     /// Check that this tree renders every shipped scene bit for bit as
     /// another build does (mis and mixture, streamed and naive, both
@@ -180,7 +185,8 @@ fn main() -> Result<()> {
             rounds,
             old,
             old_rev,
-        } => speed::run(quick, rounds, old.as_deref(), old_rev.as_deref()),
+            profile,
+        } => speed::run(quick, rounds, old.as_deref(), old_rev.as_deref(), profile),
         Command::Identical { old, old_rev } => identical::run(old.as_deref(), old_rev.as_deref()),
         Command::Instructions {
             quick,

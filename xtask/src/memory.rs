@@ -77,20 +77,78 @@ fn peak_rss_mb(program: &Path, args: &[String]) -> Result<(f64, f64)> {
     Ok((kb * 1024.0 / 1e6, secs))
 }
 
+/// The optimisation a report's `lueur` is built with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Build {
+    /// `cargo build --release`: what the README's render command runs.
+    Release,
+    /// The `dist` profile, what `cargo install --profile dist` installs: link-time
+    /// optimisation in one codegen unit. An older tree without that profile gets the
+    /// same settings from [`DIST_SETTINGS`].
+    Dist,
+}
+
+/// The workspace Cargo.toml's `[profile.dist]`, as `cargo --config` values, so that a
+/// tree of a commit before the profile existed builds the same way
+/// (`dist_settings_match_the_manifest` checks they agree).
+pub const DIST_SETTINGS: [&str; 3] = [
+    "profile.dist.inherits=\"release\"",
+    "profile.dist.lto=\"fat\"",
+    "profile.dist.codegen-units=1",
+];
+
+impl Build {
+    /// Its directory under a target directory, and the arguments that select it.
+    fn profile(self) -> (&'static str, Vec<&'static str>) {
+        match self {
+            Build::Release => ("release", vec!["--release"]),
+            Build::Dist => {
+                let mut args = vec!["--profile", "dist"];
+                for setting in DIST_SETTINGS {
+                    args.extend(["--config", setting]);
+                }
+                ("dist", args)
+            }
+        }
+    }
+
+    /// How a report names it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Build::Release => "`cargo build --release`",
+            Build::Dist => {
+                "the `dist` profile (`cargo build --profile dist`: fat LTO, one codegen unit)"
+            }
+        }
+    }
+}
+
 /// Builds this tree's release `lueur` (`cargo build --release -p lueur-cli`)
 /// and returns its path, under `$CARGO_TARGET_DIR` when that is set.
 pub fn build_lueur() -> Result<PathBuf> {
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map_or_else(|| project_root().join("target"), PathBuf::from);
-    build_lueur_from(&project_root(), &target, &[])
+    build_lueur_as(Build::Release)
 }
 
-/// Builds the release `lueur` of the workspace at `root` into the target
-/// directory `target` (`cargo build --release -p lueur-cli`, then `extra`)
-/// and returns its path.
-pub fn build_lueur_from(root: &Path, target: &Path, extra: &[&str]) -> Result<PathBuf> {
+/// [`build_lueur`] with the optimisation `build`.
+pub fn build_lueur_as(build: Build) -> Result<PathBuf> {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(|| project_root().join("target"), PathBuf::from);
+    build_lueur_from(&project_root(), &target, build, &[])
+}
+
+/// Builds `lueur` of the workspace at `root` into the target directory `target`
+/// (`cargo build -p lueur-cli` as `build` says, then `extra`) and returns its path.
+pub fn build_lueur_from(
+    root: &Path,
+    target: &Path,
+    build: Build,
+    extra: &[&str],
+) -> Result<PathBuf> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let mut args = vec!["build", "--release", "-p", "lueur-cli"];
+    let (dir, profile) = build.profile();
+    let mut args = vec!["build"];
+    args.extend(profile);
+    args.extend(["-p", "lueur-cli"]);
     args.extend(extra);
     let shown = format!("cargo {} in {}", args.join(" "), root.display());
     let status = Command::new(cargo)
@@ -100,7 +158,7 @@ pub fn build_lueur_from(root: &Path, target: &Path, extra: &[&str]) -> Result<Pa
         .status()
         .with_context(|| format!("cannot run {shown}"))?;
     ensure!(status.success(), "{shown} failed");
-    let binary = target.join("release").join("lueur");
+    let binary = target.join(dir).join("lueur");
     ensure!(binary.is_file(), "{shown} made no {}", binary.display());
     Ok(binary)
 }
@@ -276,4 +334,30 @@ fn scratch_dir() -> Result<PathBuf> {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     Ok(dir)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`DIST_SETTINGS`] are the workspace's `[profile.dist]`, key for key, so that an old
+    /// commit built with them is built as this tree's `dist` is.
+    #[test]
+    fn dist_settings_match_the_manifest() {
+        let manifest = std::fs::read_to_string(project_root().join("Cargo.toml")).unwrap();
+        let section = manifest
+            .split("\n[")
+            .find(|s| s.starts_with("profile.dist]"))
+            .expect("the workspace Cargo.toml has a [profile.dist]");
+        let keys: Vec<String> = (section.lines().skip(1))
+            .map(str::trim)
+            .filter(|l| !l.is_empty() && !l.starts_with('#'))
+            .map(|l| format!("profile.dist.{}", l.replace(' ', "")))
+            .collect();
+        let mut settings: Vec<String> = DIST_SETTINGS.iter().map(|s| s.to_string()).collect();
+        let mut keys = keys;
+        keys.sort();
+        settings.sort();
+        assert_eq!(keys, settings);
+    }
 }

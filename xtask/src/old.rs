@@ -16,7 +16,7 @@ use std::process::{Command, Stdio};
 
 use anyhow::{Context, Result, bail, ensure};
 
-use crate::memory::build_lueur_from;
+use crate::memory::{Build, build_lueur_from};
 use crate::project_root;
 use crate::reference::cache_dir;
 
@@ -30,8 +30,8 @@ pub struct Old {
 }
 
 /// The old renderer of `--old PATH` or `--old-rev REV` (at most one is
-/// given; clap enforces it), built if it is a revision.
-pub fn resolve(path: Option<&Path>, rev: Option<&str>) -> Result<Option<Old>> {
+/// given; clap enforces it), built as `build` says if it is a revision.
+pub fn resolve(path: Option<&Path>, rev: Option<&str>, build: Build) -> Result<Option<Old>> {
     match (path, rev) {
         (Some(path), _) => {
             let binary = std::fs::canonicalize(path)
@@ -44,13 +44,14 @@ pub fn resolve(path: Option<&Path>, rev: Option<&str>) -> Result<Option<Old>> {
         }
         (None, Some(rev)) => {
             let commit = commit_of(rev)?;
-            let binary = build_at(&commit)?;
+            let binary = build_at(&commit, build)?;
             Ok(Some(Old {
                 binary,
                 flag: format!("--old-rev {rev}"),
                 description: format!(
-                    "built from `{rev}` (commit {}) by `--old-rev`",
-                    &commit[..12]
+                    "built from `{rev}` (commit {}) by `--old-rev`, by {}",
+                    &commit[..12],
+                    build.describe()
                 ),
             }))
         }
@@ -77,11 +78,15 @@ fn commit_of(rev: &str) -> Result<String> {
     Ok(String::from_utf8_lossy(&out.stdout).trim().to_owned())
 }
 
-/// Builds `lueur` at `commit` (once; later calls find the binary) and
+/// Builds `lueur` at `commit` as `build` says (once; later calls find the binary) and
 /// returns its path.
-fn build_at(commit: &str) -> Result<PathBuf> {
+fn build_at(commit: &str, build: Build) -> Result<PathBuf> {
     let dir = cache_dir()?.join("old").join(&commit[..12]);
-    let binary = dir.join("target").join("release").join("lueur");
+    let profile = match build {
+        Build::Release => "release",
+        Build::Dist => "dist",
+    };
+    let binary = dir.join("target").join(profile).join("lueur");
     if binary.is_file() {
         eprintln!("old renderer: {} (built before)", binary.display());
         return Ok(binary);
@@ -94,11 +99,12 @@ fn build_at(commit: &str) -> Result<PathBuf> {
     std::fs::create_dir_all(&source).with_context(|| format!("creating {}", source.display()))?;
     export(commit, &source)?;
     eprintln!(
-        "old renderer: building commit {} in {} (a full release build)",
+        "old renderer: building commit {} in {} (a full build, {})",
         &commit[..12],
-        dir.display()
+        dir.display(),
+        build.describe()
     );
-    build_lueur_from(&source, &dir.join("target"), &["--locked"])
+    build_lueur_from(&source, &dir.join("target"), build, &["--locked"])
         .with_context(|| format!("building commit {commit}"))
 }
 

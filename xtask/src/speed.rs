@@ -23,7 +23,7 @@ use anyhow::{Context, Result};
 use lueur::integrator::Execution;
 use lueur::sdf_math::SimdLevel;
 
-use crate::memory::build_lueur;
+use crate::memory::{Build, build_lueur_as};
 use crate::old::{self, Old};
 use crate::peers::{SCENE as MITSUBA_SCENE, mitsuba, mitsuba_installed, mitsuba_version};
 use crate::reference::cache_dir;
@@ -76,11 +76,12 @@ pub fn run(
     rounds: Option<u32>,
     old_path: Option<&Path>,
     old_rev: Option<&str>,
+    build: Build,
 ) -> Result<()> {
     let plan = PLANS.pick(quick);
     let rounds = rounds.unwrap_or(plan.rounds);
-    let old = old::resolve(old_path, old_rev)?;
-    let new = build_lueur()?;
+    let old = old::resolve(old_path, old_rev, build)?;
+    let new = build_lueur_as(build)?;
     let peer = if !plan.mitsuba {
         Peer::Skipped("not run with --quick")
     } else if mitsuba_installed()? {
@@ -139,7 +140,10 @@ pub fn run(
     if let Some(old) = &old {
         write!(command, " {}", old.flag)?;
     }
-    let md = report(plan, rounds, &peer, old.as_ref(), &command, &table)?;
+    if build == Build::Dist {
+        command.push_str(" --profile dist");
+    }
+    let md = report(plan, rounds, &peer, (old.as_ref(), build), &command, &table)?;
     write_report(quick, "SPEED.md", &md)?;
     Ok(())
 }
@@ -321,7 +325,7 @@ fn report(
     plan: &Plan,
     rounds: u32,
     peer: &Peer,
-    old: Option<&Old>,
+    (old, build): (Option<&Old>, Build),
     command: &str,
     table: &str,
 ) -> Result<String> {
@@ -346,13 +350,14 @@ fn report(
         md,
         "lueur: the wall time of the whole process, `lueur {args}` from the project root \
          (start, scene parse, render and EXR write), as a user runs it; M samples/s = \
-         {size} x {size} x {spp} / seconds / 10^6. *new* is this workspace's binary \
-         (`cargo build --release -p lueur-cli`), *old* {}. {} Rounds: {rounds}, each \
+         {size} x {size} x {spp} / seconds / 10^6. *new* is this workspace's binary, \
+         built by {} (`-p lueur-cli`), *old* {}. {} Rounds: {rounds}, each \
          running on each scene, of old, new, `scalar_rgb` and `llvm_ad_rgb`, those measured, \
          in turn; a cell is the median of the rounds (min-max), and a ratio is taken within each round before \
          its median. The table by SIMD level runs the new binary once more per level in each round, \
          right after its default run on `{MITSUBA_SCENE}`; a level more than 5% faster than the \
          default is flagged.\n",
+        build.describe(),
         old.map_or("was not given (`--old PATH` or `--old-rev REV`)", |o| o
             .description
             .as_str()),
