@@ -116,9 +116,7 @@ impl Build {
     pub fn describe(self) -> &'static str {
         match self {
             Build::Release => "`cargo build --release`",
-            Build::Dist => {
-                "the `dist` profile (`cargo build --profile dist`: fat LTO, one codegen unit)"
-            }
+            Build::Dist => "`cargo build --profile dist` (fat LTO, one codegen unit)",
         }
     }
 }

@@ -49,7 +49,7 @@ pub fn resolve(path: Option<&Path>, rev: Option<&str>, build: Build) -> Result<O
                 binary,
                 flag: format!("--old-rev {rev}"),
                 description: format!(
-                    "built from `{rev}` (commit {}) by `--old-rev`, by {}",
+                    "built from `{rev}` (commit {}) by `--old-rev`, with {}",
                     &commit[..12],
                     build.describe()
                 ),

@@ -350,8 +350,8 @@ fn report(
         md,
         "lueur: the wall time of the whole process, `lueur {args}` from the project root \
          (start, scene parse, render and EXR write), as a user runs it; M samples/s = \
-         {size} x {size} x {spp} / seconds / 10^6. *new* is this workspace's binary, \
-         built by {} (`-p lueur-cli`), *old* {}. {} Rounds: {rounds}, each \
+         {size} x {size} x {spp} / seconds / 10^6. *new* is this workspace's `lueur-cli`, \
+         built by {}; *old* {}. {} Rounds: {rounds}, each \
          running on each scene, of old, new, `scalar_rgb` and `llvm_ad_rgb`, those measured, \
          in turn; a cell is the median of the rounds (min-max), and a ratio is taken within each round before \
          its median. The table by SIMD level runs the new binary once more per level in each round, \
