@@ -98,16 +98,24 @@ pub const DIST_SETTINGS: [&str; 3] = [
 ];
 
 impl Build {
-    /// Its directory under a target directory, and the arguments that select it.
-    fn profile(self) -> (&'static str, Vec<&'static str>) {
+    /// Its directory under a target directory.
+    pub fn dir(self) -> &'static str {
         match self {
-            Build::Release => ("release", vec!["--release"]),
+            Build::Release => "release",
+            Build::Dist => "dist",
+        }
+    }
+
+    /// The arguments of `cargo build` that select it.
+    fn args(self) -> Vec<&'static str> {
+        match self {
+            Build::Release => vec!["--release"],
             Build::Dist => {
                 let mut args = vec!["--profile", "dist"];
                 for setting in DIST_SETTINGS {
                     args.extend(["--config", setting]);
                 }
-                ("dist", args)
+                args
             }
         }
     }
@@ -143,9 +151,8 @@ pub fn build_lueur_from(
     extra: &[&str],
 ) -> Result<PathBuf> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let (dir, profile) = build.profile();
     let mut args = vec!["build"];
-    args.extend(profile);
+    args.extend(build.args());
     args.extend(["-p", "lueur-cli"]);
     args.extend(extra);
     let shown = format!("cargo {} in {}", args.join(" "), root.display());
@@ -156,7 +163,7 @@ pub fn build_lueur_from(
         .status()
         .with_context(|| format!("cannot run {shown}"))?;
     ensure!(status.success(), "{shown} failed");
-    let binary = target.join(dir).join("lueur");
+    let binary = target.join(build.dir()).join("lueur");
     ensure!(binary.is_file(), "{shown} made no {}", binary.display());
     Ok(binary)
 }
@@ -347,13 +354,12 @@ mod tests {
             .split("\n[")
             .find(|s| s.starts_with("profile.dist]"))
             .expect("the workspace Cargo.toml has a [profile.dist]");
-        let keys: Vec<String> = (section.lines().skip(1))
+        let mut keys: Vec<String> = (section.lines().skip(1))
             .map(str::trim)
             .filter(|l| !l.is_empty() && !l.starts_with('#'))
             .map(|l| format!("profile.dist.{}", l.replace(' ', "")))
             .collect();
         let mut settings: Vec<String> = DIST_SETTINGS.iter().map(|s| s.to_string()).collect();
-        let mut keys = keys;
         keys.sort();
         settings.sort();
         assert_eq!(keys, settings);

@@ -82,11 +82,7 @@ fn commit_of(rev: &str) -> Result<String> {
 /// returns its path.
 fn build_at(commit: &str, build: Build) -> Result<PathBuf> {
     let dir = cache_dir()?.join("old").join(&commit[..12]);
-    let profile = match build {
-        Build::Release => "release",
-        Build::Dist => "dist",
-    };
-    let binary = dir.join("target").join(profile).join("lueur");
+    let binary = dir.join("target").join(build.dir()).join("lueur");
     if binary.is_file() {
         eprintln!("old renderer: {} (built before)", binary.display());
         return Ok(binary);
