@@ -129,6 +129,24 @@ impl Build {
     }
 }
 
+/// How this xtask was built, from the directory its binary is in (cargo's
+/// `target/PROFILE/`): a report that renders with lueur's crates inside xtask
+/// (`peers`) measures that build. `cargo xtask` is `release`; `cargo xtask-dist`
+/// is `dist`.
+pub fn this_build() -> String {
+    let exe = std::env::current_exe().ok();
+    let profile = (exe.as_deref())
+        .and_then(Path::parent)
+        .and_then(Path::file_name)
+        .and_then(|dir| dir.to_str());
+    match profile {
+        Some("release") => Build::Release.describe().to_owned(),
+        Some("dist") => Build::Dist.describe().to_owned(),
+        Some(other) => format!("the `{other}` profile"),
+        None => "an unknown profile".to_owned(),
+    }
+}
+
 /// Builds this tree's release `lueur` (`cargo build --release -p lueur-cli`)
 /// and returns its path, under `$CARGO_TARGET_DIR` when that is set.
 pub fn build_lueur() -> Result<PathBuf> {

@@ -34,6 +34,7 @@ use lueur::sampling::SamplerKind;
 use lueur::scene::SceneFile;
 use lueur::scene::{RenderSettings, Strategy};
 
+use crate::memory::this_build;
 use crate::reference::{Reference, cache_dir, flatten, render_film};
 use crate::report::{Plans, write_report};
 use crate::{load_scene, project_root};
@@ -539,8 +540,9 @@ fn report(
     writeln!(md, "## Speed and error\n")?;
     writeln!(
         md,
-        "Render time (lueur: its own measured render; Mitsuba: the render after a first one, \
-         so a JIT variant's kernel compile, shown apart with the first round's, is not counted), \
+        "Render time (lueur: its own measured render, in xtask's process, built by {}; Mitsuba: \
+         the render after a first one, so a JIT variant's kernel compile, shown apart with the \
+         first round's, is not counted), \
          median of {} rounds in which every configuration renders at every spp, interleaved \
          (their order reversed every other round). \
          MSE against the reference, less the reference's own variance. **MSE x time** is what \
@@ -548,6 +550,7 @@ fn report(
          better). lueur's default sampler runs twice: with its default replicates, which give \
          each pixel an error bar, and with 1, which gives that up for one point set of the \
          whole spp per pixel (docs/REPLICATES.md).\n",
+        this_build(),
         plan.rounds
     )?;
     writeln!(
