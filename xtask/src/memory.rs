@@ -139,11 +139,13 @@ pub fn this_build() -> String {
         .and_then(Path::parent)
         .and_then(Path::file_name)
         .and_then(|dir| dir.to_str());
-    match profile {
-        Some("release") => Build::Release.describe().to_owned(),
-        Some("dist") => Build::Dist.describe().to_owned(),
-        Some(other) => format!("the `{other}` profile"),
-        None => "an unknown profile".to_owned(),
+    let known = <Build as clap::ValueEnum>::value_variants()
+        .iter()
+        .find(|b| Some(b.dir()) == profile);
+    match (known, profile) {
+        (Some(build), _) => build.describe().to_owned(),
+        (None, Some(other)) => format!("the `{other}` profile"),
+        (None, None) => "an unknown profile".to_owned(),
     }
 }
 
