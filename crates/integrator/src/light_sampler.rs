@@ -13,6 +13,8 @@ use lueur_sdf_math::{Lane, LaneGroups, LaneKernel, LaneVec3, MAX_LANES, SimdLeve
 
 use lueur_scene::{EmitterSample, Light, QuadSampling};
 
+use crate::strategy::CosineDraws;
+
 /// An emitter that light sampling can choose.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Emitter {
@@ -27,9 +29,30 @@ pub(crate) enum Emitter {
 pub(crate) enum Drawn<'a> {
     /// A light's ([`SphereDraws`], [`RectangleDraws`]).
     Light(&'a Option<DirectionSample>),
-    /// The sky's cosine-weighted direction in the normal's frame
-    /// ([`crate::strategy::CosineDraws`]).
-    Cosine(Vec3),
+    /// The sky's cosine-weighted direction in the normal's frame: request `k` of the
+    /// wave's [`CosineDraws`]. Read where it is used: copied out first, the direction is
+    /// stored in pieces and loaded whole (docs/PERFORMANCE.md, "Stores loaded whole").
+    Cosine(&'a CosineDraws, usize),
+}
+
+/// The sky's sample toward the cosine-weighted direction `local` in the frame of the
+/// normal `n`, of the emitters' choice chosen with probability `pmf`.
+#[inline(always)]
+fn sky_sample(sky: Vec3, n: Vec3, local: Vec3, pmf: f32) -> Option<(EmitterSample, Option<usize>)> {
+    let pdf = cosine_hemisphere_pdf(local.z);
+    if !(pdf > 0.0) {
+        return None;
+    }
+    let wi = Frame::from_normal(n).to_world(local).normalize();
+    Some((
+        EmitterSample {
+            wi,
+            distance: f32::INFINITY,
+            radiance: sky,
+            pdf: pdf * pmf,
+        },
+        None,
+    ))
 }
 
 /// The choice among emitters: uniform over the lights that are not delta
@@ -140,7 +163,7 @@ impl Emitters<'_> {
     }
 
     /// Whether `u_choice` makes [`Emitters::sample`] aim at the sky, whose cosine-weighted
-    /// directions a wave draws with its others ([`crate::strategy::CosineDraws`]).
+    /// directions a wave draws with its others ([`CosineDraws`]).
     #[inline]
     pub fn chosen_sky(&self, u_choice: f32) -> bool {
         self.sky.is_some() && matches!(self.sampler.choose(u_choice), Some((Emitter::Sky, _)))
@@ -161,27 +184,16 @@ impl Emitters<'_> {
         match emitter {
             Emitter::Sky => {
                 let sky = self.sky?;
-                let local = match drawn {
-                    Some(Drawn::Cosine(local)) => {
-                        debug_assert_eq!(local, sample_cosine_hemisphere(u));
-                        local
+                // A sample per arm: where the arms meet in one local direction, it is
+                // stored in pieces and loaded whole (docs/PERFORMANCE.md, "Stores loaded
+                // whole").
+                match drawn {
+                    Some(Drawn::Cosine(draws, k)) => {
+                        debug_assert_eq!(draws.drawn(k), sample_cosine_hemisphere(u));
+                        sky_sample(sky, n, draws.drawn(k), pmf)
                     }
-                    _ => sample_cosine_hemisphere(u),
-                };
-                let pdf = cosine_hemisphere_pdf(local.z);
-                if !(pdf > 0.0) {
-                    return None;
+                    _ => sky_sample(sky, n, sample_cosine_hemisphere(u), pmf),
                 }
-                let wi = Frame::from_normal(n).to_world(local).normalize();
-                Some((
-                    EmitterSample {
-                        wi,
-                        distance: f32::INFINITY,
-                        radiance: sky,
-                        pdf: pdf * pmf,
-                    },
-                    None,
-                ))
             }
             Emitter::Light(i) => {
                 let light = &self.lights[i];

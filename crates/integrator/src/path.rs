@@ -168,11 +168,11 @@ impl LightDraws {
 
     /// The sample `light` names, drawn (the sky's among the wave's `cosines`).
     #[inline(always)]
-    fn drawn<'a>(&'a self, light: LightDraw, cosines: &CosineDraws) -> Drawn<'a> {
+    fn drawn<'a>(&'a self, light: LightDraw, cosines: &'a CosineDraws) -> Drawn<'a> {
         match light {
             LightDraw::Sphere(k) => Drawn::Light(&self.spheres.drawn[k]),
             LightDraw::Rectangle(k) => Drawn::Light(&self.rectangles.drawn[k]),
-            LightDraw::Sky(k) => Drawn::Cosine(cosines.drawn(k)),
+            LightDraw::Sky(k) => Drawn::Cosine(cosines, k),
         }
     }
 }
@@ -213,8 +213,6 @@ pub(crate) struct WaveScratch {
 struct ShadowQueue {
     rays: Vec<ShadowRay>,
     contributions: Vec<Vec3>,
-    /// One vertex's delta lights, before they join the queue.
-    lights: Vec<(ShadowRay, Vec3)>,
 }
 
 /// The material of the object a path met.
@@ -263,12 +261,7 @@ fn shade(
             out.scatter = strategy::mirror(&vertex, u.bsdf);
         }
         Material::Lambertian { .. } => {
-            shadow.lights.clear();
-            lighting.delta_lights(&vertex, &mut shadow.lights);
-            for (ray, contribution) in shadow.lights.drain(..) {
-                shadow.rays.push(ray);
-                shadow.contributions.push(contribution);
-            }
+            lighting.delta_lights(&vertex, &mut shadow.rays, &mut shadow.contributions);
             out.diffuse = true;
             // Pushed where it is made: moved through an `Option` and an iterator chain,
             // the ray is stored in pieces and loaded whole, and the load waits for the
@@ -282,14 +275,13 @@ fn shade(
                     }
                     None => false,
                 };
-            let cosine = cosine.map(|k| scatters.drawn(k));
             let emitters = &lighting.emitters;
             strategy::scatter_into(
                 settings.strategy,
                 emitters,
                 &vertex,
                 u,
-                cosine,
+                (scatters, cosine),
                 &mut out.scatter,
             );
         }

@@ -181,23 +181,31 @@ pub(crate) fn scatter(
     }
 }
 
-/// [`scatter`], written into `out`: MIS, the default, inline, into the slot as it is made;
-/// the other strategies through a call. Through one `match`, the arms' results meet in a
-/// temporary stored in pieces and loaded whole, and the shading waits on the load
-/// (docs/PERFORMANCE.md, "Stores loaded whole").
+/// [`scatter`], written into `out`; `cosine` is the index of the vertex's request in
+/// `scatters` where the wave drew its sample by the cosine. MIS, the default, is written
+/// inline, from the drawn rows into the slot a field at a time; the other strategies go
+/// through a call. Through one `match`, or through [`CosineScatters::drawn`]'s `Option`,
+/// the results meet in a temporary stored in pieces and loaded whole, and the shading
+/// waits on the load (docs/PERFORMANCE.md, "Stores loaded whole").
 #[inline(always)]
 pub(crate) fn scatter_into(
     strategy: Strategy,
     emitters: &Emitters<'_>,
     v: &Vertex<'_>,
     u: &VertexSample,
-    cosine: Option<Option<DrawnScatter>>,
+    (scatters, cosine): (&CosineScatters, Option<usize>),
     out: &mut Option<Scatter>,
 ) {
-    if strategy == Strategy::Mis {
-        *out = mis_bsdf(v, u.bsdf, cosine);
-    } else {
-        scatter_out_of_line(strategy, emitters, v, u, cosine, out);
+    match (strategy, cosine) {
+        (Strategy::Mis, Some(k)) => {
+            scatters.mis_bsdf_into(k, out);
+            debug_assert_eq!(*out, mis_bsdf(v, u.bsdf, None));
+        }
+        (Strategy::Mis, None) => *out = mis_bsdf(v, u.bsdf, None),
+        _ => {
+            let cosine = cosine.map(|k| scatters.drawn(k));
+            scatter_out_of_line(strategy, emitters, v, u, cosine, out);
+        }
     }
 }
 
@@ -391,6 +399,26 @@ impl CosineScatters {
             weight: Vec3::new(fx[lane], fy[lane], fz[lane]),
             pdf: pdf[lane],
         })
+    }
+
+    /// [`mis_bsdf`] of request `k`'s sample, after [`CosineScatters::draw`], written
+    /// into `out` a field at a time from the rows.
+    #[inline(always)]
+    pub fn mis_bsdf_into(&self, k: usize, out: &mut Option<Scatter>) {
+        debug_assert!(k < self.inputs.len());
+        let [wx, wy, wz, fx, fy, fz, pdf, valid] = &self.drawn[k / MAX_LANES];
+        let lane = k % MAX_LANES;
+        if valid[lane] == 0.0 {
+            *out = None;
+            return;
+        }
+        let pdf = pdf[lane];
+        *out = Some(Scatter {
+            wi: Vec3::new(wx[lane], wy[lane], wz[lane]),
+            weight: Vec3::new(fx[lane], fy[lane], fz[lane]),
+            pdf,
+            emission: EmissionWeight::PowerHeuristic { bsdf_pdf: pdf },
+        });
     }
 
     /// How many requests were drawn.
@@ -616,11 +644,19 @@ impl<'a> Lighting<'a> {
     }
 
     /// The light every delta light would bring, with the shadow ray each needs (a delta
-    /// light can be reached no other way), pushed to `out` in the lights' order; the
-    /// vertex gathers the sum of those whose ray is free, in that order.
+    /// light can be reached no other way), pushed to `contributions` and `rays` in the
+    /// lights' order; the vertex gathers the sum of those whose ray is free, in that order.
+    /// Pushed where they are made: through a `Vec` of pairs, or built whole, the ray's
+    /// origin is stored in pieces and loaded whole (docs/PERFORMANCE.md, "Stores loaded
+    /// whole").
     #[inline]
-    pub fn delta_lights(&self, v: &Vertex<'_>, out: &mut Vec<(ShadowRay, Vec3)>) {
-        let (n, wo) = (v.at.n, v.wo);
+    pub fn delta_lights(
+        &self,
+        v: &Vertex<'_>,
+        rays: &mut Vec<ShadowRay>,
+        contributions: &mut Vec<Vec3>,
+    ) {
+        let (n, wo, origin) = (v.at.n, v.wo, v.at.origin);
         for light in &self.scene.scene().lights {
             let Some((wi, irradiance)) = light.delta_arrival() else {
                 continue;
@@ -633,12 +669,11 @@ impl<'a> Lighting<'a> {
             if f == Vec3::ZERO {
                 continue;
             }
-            let ray = ShadowRay {
-                ray: Ray::new(v.at.origin, wi),
-                distance: f32::INFINITY,
-                target: None,
-            };
-            out.push((ray, f * irradiance * cos));
+            rays.push(ShadowRay::UNSET);
+            let slot = rays.last_mut().expect("pushed");
+            slot.ray = Ray::new(origin, wi);
+            slot.distance = f32::INFINITY;
+            contributions.push(f * irradiance * cos);
         }
     }
 
@@ -1017,7 +1052,7 @@ mod tests {
             for (&k, &(choice, e, n)) in indices.iter().zip(&asked) {
                 let p = Vec3::ZERO;
                 let through =
-                    emitters.sample_drawn(p, n, choice, e, Some(Drawn::Cosine(draws.drawn(k))));
+                    emitters.sample_drawn(p, n, choice, e, Some(Drawn::Cosine(&draws, k)));
                 let alone = emitters.sample(p, n, choice, e);
                 assert!(alone.is_some_and(|(_, light)| light.is_none()), "the sky");
                 assert_eq!(through, alone, "{level:?}: {choice} {e} {n}");

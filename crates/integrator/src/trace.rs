@@ -199,6 +199,15 @@ pub(crate) struct ShadowRay {
     pub target: Option<usize>,
 }
 
+impl ShadowRay {
+    /// A placeholder for a slot about to be written.
+    pub const UNSET: ShadowRay = ShadowRay {
+        ray: PathRay::UNSET.ray,
+        distance: 0.0,
+        target: None,
+    };
+}
+
 /// How rays are traced: the marching mode, and the instruction set fast marching's
 /// streams run on (every level gives the same bits).
 #[derive(Clone, Copy, Debug)]

@@ -222,12 +222,22 @@ impl LaneDistance for Sdf {
     fn distance_lanes<L: Lane>(&self, p: LaneVec3<L>) -> L {
         match self {
             Self::Primitive(shape) => shape.distance_lanes(p),
-            _ => self.node_distance(p),
+            _ => self.node_distance_apart(&p),
         }
     }
 }
 
 impl Sdf {
+    /// [`Sdf::node_distance`], called apart: marked cold so that a kernel marching
+    /// primitives keeps the point in registers. Otherwise the compiler may store the point's
+    /// vectors for this call before the branch, on every evaluation, and the primitive's
+    /// loads wait on those stores (docs/PERFORMANCE.md, "Stores loaded whole").
+    #[cold]
+    #[inline(never)]
+    fn node_distance_apart<L: Lane>(&self, p: &LaneVec3<L>) -> L {
+        self.node_distance(*p)
+    }
+
     #[inline]
     fn node_distance<L: Lane>(&self, p: LaneVec3<L>) -> L {
         let inf = L::splat(f32::INFINITY);
