@@ -980,6 +980,16 @@ mod tests {
                         alone,
                         "{level:?}, {count} requests, u = {u}"
                     );
+                    // What `mis` scatters by, written from the rows: the same sample.
+                    let mut mis = None;
+                    draws.mis_bsdf_into(k, &mut mis);
+                    let expected = alone.map(|s| Scatter {
+                        wi: s.wi,
+                        weight: s.weight,
+                        pdf: s.pdf,
+                        emission: EmissionWeight::PowerHeuristic { bsdf_pdf: s.pdf },
+                    });
+                    assert_eq!(mis, expected, "{level:?}, {count} requests, u = {u}");
                 }
             }
         }
