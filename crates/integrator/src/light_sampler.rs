@@ -1,19 +1,20 @@
 //! The emitter choice (pbrt-v4's `LightSampler`): which emitter light
 //! sampling aims at, with what probability, and the pdfs of the directions
 //! that result, summed over the emitters. The sky is an emitter like the
-//! lights with an area, sampled by the cosine around the normal.
+//! lights with an area, sampled by the cosine around the normal. And the
+//! direction samples a wave of paths draws together for next-event
+//! estimation: toward sphere lights (`SphereDraws`), rectangles
+//! (`RectangleDraws`) and the sky (`CosineDraws`).
 
 use glam::{Vec2, Vec3};
 use lueur_sampling::{
     DirectionSample, DiscreteDistribution, Frame, RECTANGLE_LANES, RectangleFrame,
     SphericalRectangles, cosine_hemisphere_pdf, sample_cosine_hemisphere,
-    sample_sphere_light_lanes,
+    sample_cosine_hemisphere_lanes, sample_sphere_light_lanes,
 };
 use lueur_sdf_math::{Lane, LaneGroups, LaneKernel, LaneVec3, MAX_LANES, SimdLevel};
 
 use lueur_scene::{EmitterSample, Light, QuadSampling};
-
-use crate::strategy::CosineDraws;
 
 /// An emitter that light sampling can choose.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -435,6 +436,108 @@ impl LaneKernel for DrawSpheres<'_> {
                     normal: Vec3::new(out[8][lane], out[9][lane], out[10][lane]),
                 })
             }));
+        }
+    }
+}
+
+/// The cosine-weighted local directions of a wave's next-event estimation toward the sky,
+/// drawn together, a request per lane ([`sample_cosine_hemisphere_lanes`]): each is the bits
+/// `sample_cosine_hemisphere` gives for its numbers alone, whatever its company and the
+/// SIMD level. One is a chain of a division, a sine and cosine, and a square root, which
+/// the shading of its vertex would wait on; in lanes, a vector of them costs about what
+/// one does.
+#[derive(Debug, Default)]
+pub(crate) struct CosineDraws {
+    /// Per request, its two numbers, padded with zeros to whole vectors when drawn.
+    u0: Vec<f32>,
+    u1: Vec<f32>,
+    /// Per request, after [`CosineDraws::draw`]: its direction's coordinates, one row
+    /// each, as the kernel stores its vectors (a `Vec3` per lane, picked out of them one
+    /// at a time, took most of the kernel's time).
+    drawn: [Vec<f32>; 3],
+    /// How many requests were drawn.
+    len: usize,
+}
+
+impl CosineDraws {
+    pub fn clear(&mut self) {
+        self.u0.clear();
+        self.u1.clear();
+        self.len = 0;
+    }
+
+    /// Request `k`'s direction, after [`CosineDraws::draw`].
+    #[inline(always)]
+    pub fn drawn(&self, k: usize) -> Vec3 {
+        debug_assert!(k < self.len);
+        let [x, y, z] = &self.drawn;
+        Vec3::new(x[k], y[k], z[k])
+    }
+
+    /// How many requests were drawn.
+    #[cfg(test)]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Asks for the direction of `u`; its index in `drawn`.
+    pub fn request(&mut self, u: Vec2) -> usize {
+        self.u0.push(u.x);
+        self.u1.push(u.y);
+        self.u0.len() - 1
+    }
+
+    /// Draws every request's direction on `level` (the widest available where it is not).
+    pub fn draw(&mut self, level: SimdLevel) {
+        let n = self.u0.len();
+        self.len = n;
+        if n == 0 {
+            return;
+        }
+        // Whole vectors of the widest level, so that every load and store is of a known
+        // length.
+        let padded = n.next_multiple_of(MAX_LANES);
+        self.u0.resize(padded, 0.0);
+        self.u1.resize(padded, 0.0);
+        for row in &mut self.drawn {
+            row.resize(padded, 0.0);
+        }
+        // The level is available: `or_widest` says so.
+        let _ = level.or_widest().dispatch(DrawCosines {
+            u: [&self.u0, &self.u1],
+            n,
+            drawn: &mut self.drawn,
+        });
+    }
+}
+
+/// The kernel of [`CosineDraws::draw`].
+struct DrawCosines<'a> {
+    u: [&'a [f32]; 2],
+    n: usize,
+    drawn: &'a mut [Vec<f32>; 3],
+}
+
+impl LaneKernel for DrawCosines<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let DrawCosines {
+            u: [u0, u1],
+            n,
+            drawn: [x, y, z],
+        } = self;
+        let width = L::LANES.min(MAX_LANES);
+        for start in (0..n).step_by(width) {
+            let lanes = start..start + width;
+            let d = sample_cosine_hemisphere_lanes([
+                L::load(&u0[lanes.clone()]),
+                L::load(&u1[lanes.clone()]),
+            ]);
+            d.x.store(&mut x[lanes.clone()]);
+            d.y.store(&mut y[lanes.clone()]);
+            d.z.store(&mut z[lanes]);
         }
     }
 }

@@ -14,13 +14,13 @@ use lueur_sdf_math::{Ray, SimdLevel};
 use lueur_sdf_math::TraceParams;
 
 use crate::strategy::{
-    self, CosineDraws, CosineScatters, EmissionWeight, Lighting, Scatter, Vertex, VertexSample,
+    self, CosineScatters, EmissionWeight, Lighting, Scatter, Vertex, VertexSample,
 };
 use crate::surface::{March, SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::{PathRay, RayCounters, ShadowRay, TraceScratch, Tracing};
 use lueur_scene::RenderSettings;
 
-use crate::light_sampler::{Drawn, Emitters, RectangleDraws, SphereDraws};
+use crate::light_sampler::{CosineDraws, Drawn, Emitters, RectangleDraws, SphereDraws};
 use crate::{Hit, PreparedScene};
 
 /// State carried from one vertex to the next for weighting emission.

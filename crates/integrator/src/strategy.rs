@@ -240,108 +240,6 @@ pub(crate) fn scatters_by_cosine(strategy: Strategy) -> bool {
     }
 }
 
-/// The cosine-weighted local directions of a wave's next-event estimation toward the sky,
-/// drawn together, a request per lane ([`sample_cosine_hemisphere_lanes`]): each is the bits
-/// `sample_cosine_hemisphere` gives for its numbers alone, whatever its company and the
-/// SIMD level. One is a chain of a division, a sine and cosine, and a square root, which
-/// the shading of its vertex would wait on; in lanes, a vector of them costs about what
-/// one does.
-#[derive(Debug, Default)]
-pub(crate) struct CosineDraws {
-    /// Per request, its two numbers, padded with zeros to whole vectors when drawn.
-    u0: Vec<f32>,
-    u1: Vec<f32>,
-    /// Per request, after [`CosineDraws::draw`]: its direction's coordinates, one row
-    /// each, as the kernel stores its vectors (a `Vec3` per lane, picked out of them one
-    /// at a time, took most of the kernel's time).
-    drawn: [Vec<f32>; 3],
-    /// How many requests were drawn.
-    len: usize,
-}
-
-impl CosineDraws {
-    pub fn clear(&mut self) {
-        self.u0.clear();
-        self.u1.clear();
-        self.len = 0;
-    }
-
-    /// Request `k`'s direction, after [`CosineDraws::draw`].
-    #[inline(always)]
-    pub fn drawn(&self, k: usize) -> Vec3 {
-        debug_assert!(k < self.len);
-        let [x, y, z] = &self.drawn;
-        Vec3::new(x[k], y[k], z[k])
-    }
-
-    /// How many requests were drawn.
-    #[cfg(test)]
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// Asks for the direction of `u`; its index in `drawn`.
-    pub fn request(&mut self, u: Vec2) -> usize {
-        self.u0.push(u.x);
-        self.u1.push(u.y);
-        self.u0.len() - 1
-    }
-
-    /// Draws every request's direction on `level` (the widest available where it is not).
-    pub fn draw(&mut self, level: SimdLevel) {
-        let n = self.u0.len();
-        self.len = n;
-        if n == 0 {
-            return;
-        }
-        // Whole vectors of the widest level, so that every load and store is of a known
-        // length.
-        let padded = n.next_multiple_of(MAX_LANES);
-        self.u0.resize(padded, 0.0);
-        self.u1.resize(padded, 0.0);
-        for row in &mut self.drawn {
-            row.resize(padded, 0.0);
-        }
-        // The level is available: `or_widest` says so.
-        let _ = level.or_widest().dispatch(DrawCosines {
-            u: [&self.u0, &self.u1],
-            n,
-            drawn: &mut self.drawn,
-        });
-    }
-}
-
-/// The kernel of [`CosineDraws::draw`].
-struct DrawCosines<'a> {
-    u: [&'a [f32]; 2],
-    n: usize,
-    drawn: &'a mut [Vec<f32>; 3],
-}
-
-impl LaneKernel for DrawCosines<'_> {
-    type Output = ();
-
-    #[inline(always)]
-    fn run<L: Lane>(self) {
-        let DrawCosines {
-            u: [u0, u1],
-            n,
-            drawn: [x, y, z],
-        } = self;
-        let width = L::LANES.min(MAX_LANES);
-        for start in (0..n).step_by(width) {
-            let lanes = start..start + width;
-            let d = sample_cosine_hemisphere_lanes([
-                L::load(&u0[lanes.clone()]),
-                L::load(&u1[lanes.clone()]),
-            ]);
-            d.x.store(&mut x[lanes.clone()]);
-            d.y.store(&mut y[lanes.clone()]);
-            d.z.store(&mut z[lanes]);
-        }
-    }
-}
-
 /// A diffuse vertex's sample of its BSDF by the cosine, as a wave draws it
 /// ([`CosineScatters`]): the direction, its weight `f |cos| / pdf`, and its pdf.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -683,7 +581,7 @@ impl<'a> Lighting<'a> {
     ///
     /// `drawn` is the chosen emitter's direction sample where the wave drew it already
     /// ([`crate::light_sampler::SphereDraws`], [`crate::light_sampler::RectangleDraws`],
-    /// or the sky's in [`CosineDraws`]), `None` otherwise.
+    /// or the sky's in [`crate::light_sampler::CosineDraws`]), `None` otherwise.
     #[inline]
     pub fn next_event(
         &self,
@@ -719,7 +617,7 @@ mod tests {
     //! normal (`lueur_stats::DirectionBins`), after checking that the pdf
     //! each sample reports is the strategy's pdf at its direction.
     use super::*;
-    use crate::light_sampler::{RectangleDraws, SphereDraws};
+    use crate::light_sampler::{CosineDraws, RectangleDraws, SphereDraws};
     use lueur_scene::{Camera, Light, QuadSampling, Scene};
     use lueur_stats::DirectionBins;
 
