@@ -96,6 +96,14 @@ impl LightSampler {
         self.choice.is_none()
     }
 
+    /// Whether choosing an emitter reads its number (`u_choice`): not with one emitter
+    /// or none.
+    pub fn choice_reads_u(&self) -> bool {
+        self.choice
+            .as_ref()
+            .is_some_and(DiscreteDistribution::reads_u)
+    }
+
     /// The emitter `u` chooses and the probability of choosing it.
     fn choose(&self, u: f32) -> Option<(Emitter, f32)> {
         let (k, pmf) = self.choice.as_ref()?.sample(u);

@@ -14,7 +14,7 @@ use lueur_sdf_math::{Ray, SimdLevel};
 use lueur_sdf_math::TraceParams;
 
 use crate::strategy::{
-    self, CosineScatters, EmissionWeight, Lighting, Scatter, Vertex, VertexSample,
+    self, CosineScatters, EmissionWeight, Lighting, Scatter, Vertex, VertexReads, VertexSample,
 };
 use crate::surface::{March, SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::{PathRay, RayCounters, ShadowRay, TraceScratch, Tracing};
@@ -326,6 +326,7 @@ pub(crate) fn radiance_wave(
     } = *estimator;
     let width = width.max(1);
     let lighting = Lighting::of(scene, settings, &march);
+    let chooses = lighting.emitters.sampler.choice_reads_u();
     let s = scratch;
     s.paths.clear();
     s.samplers.clear();
@@ -442,22 +443,24 @@ pub(crate) fn radiance_wave(
                 cosine: None,
             });
             let pending = s.pending.last_mut().expect("pushed");
-            pending.u.draw(
-                &mut s.samplers[i],
-                path.id.pixel,
-                path.id.index,
-                path.depth,
-                settings.strategy,
-            );
-            let u = &pending.u;
-            // Next-event estimation toward a sphere or rectangle light or the sky, and the
-            // cosine-weighted direction a diffuse vertex scatters in: drawn below, with the
-            // wave's others.
             let albedo = match material_at(scene, on_surface) {
                 Material::Lambertian { albedo } => Some(albedo),
                 Material::Mirror { .. } => None,
             };
             let diffuse = albedo.is_some();
+            // Roulette may end the path after this vertex, whose depth `scatter` counts.
+            let roulette = path.depth + 1 >= settings.roulette_depth;
+            pending.u.draw(
+                &mut s.samplers[i],
+                path.id.pixel,
+                path.id.index,
+                path.depth,
+                VertexReads::of(settings.strategy, diffuse, chooses, roulette),
+            );
+            let u = &pending.u;
+            // Next-event estimation toward a sphere or rectangle light or the sky, and the
+            // cosine-weighted direction a diffuse vertex scatters in: drawn below, with the
+            // wave's others.
             let next_event = strategy::uses_next_event(settings.strategy) && diffuse;
             let emitters = &lighting.emitters;
             pending.light = if !next_event {

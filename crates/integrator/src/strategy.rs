@@ -55,9 +55,9 @@ impl VertexSample {
     };
 
     /// Draws into `self` the numbers of vertex `depth` of sample `index` of `pixel` that
-    /// `strategy` uses; the others are skipped (left 0), which changes no number drawn:
-    /// each has its dimension whatever is drawn before it. Filled in place, a field at a
-    /// time, as each number is drawn.
+    /// anything will read (`reads`); the others are skipped (left 0), which changes no
+    /// number drawn: each has its dimension whatever is drawn before it. Filled in place,
+    /// a field at a time, as each number is drawn.
     #[inline]
     pub fn draw(
         &mut self,
@@ -65,25 +65,77 @@ impl VertexSample {
         pixel: [u32; 2],
         index: u32,
         depth: u32,
-        strategy: Strategy,
+        reads: VertexReads,
     ) {
         sampler.start_pixel_sample(pixel, index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
-        if samples_emitters(strategy) {
-            self.emitter_choice = sampler.next_1d();
-            self.emitter = sampler.next_2d();
-        } else {
-            sampler.skip(3);
-            self.emitter_choice = 0.0;
-            self.emitter = Vec2::ZERO;
-        }
-        if strategy == Strategy::Mixture {
-            self.mixture = sampler.next_1d();
+        self.emitter_choice = if reads.emitter_choice {
+            sampler.next_1d()
         } else {
             sampler.skip(1);
-            self.mixture = 0.0;
+            0.0
+        };
+        self.emitter = if reads.emitter {
+            sampler.next_2d()
+        } else {
+            sampler.skip(2);
+            Vec2::ZERO
+        };
+        self.mixture = if reads.mixture {
+            sampler.next_1d()
+        } else {
+            sampler.skip(1);
+            0.0
+        };
+        self.bsdf = if reads.bsdf {
+            sampler.next_2d()
+        } else {
+            sampler.skip(2);
+            Vec2::ZERO
+        };
+        self.roulette = if reads.roulette {
+            sampler.next_1d()
+        } else {
+            0.0
+        };
+    }
+}
+
+/// Which of a vertex's numbers ([`VertexSample`]) anything reads: only those are drawn
+/// (with the hashed samplers, each is a chain of 64-bit hashes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct VertexReads {
+    pub emitter_choice: bool,
+    pub emitter: bool,
+    pub mixture: bool,
+    pub bsdf: bool,
+    pub roulette: bool,
+}
+
+impl VertexReads {
+    /// Every number.
+    pub const ALL: VertexReads = VertexReads {
+        emitter_choice: true,
+        emitter: true,
+        mixture: true,
+        bsdf: true,
+        roulette: true,
+    };
+
+    /// What `strategy` reads at a vertex: a mirror reads no number of its own (its
+    /// direction is fixed, and no strategy samples an emitter there); a diffuse vertex
+    /// reads the emitter's numbers where the strategy samples emitters (the choice only
+    /// where there is one, `chooses`), the mixture's where it mixes, and the BSDF's
+    /// unless it samples lights only. The roulette number is read where roulette may end
+    /// the path after this vertex (`roulette`).
+    pub fn of(strategy: Strategy, diffuse: bool, chooses: bool, roulette: bool) -> VertexReads {
+        let emitters = diffuse && samples_emitters(strategy);
+        VertexReads {
+            emitter_choice: emitters && chooses,
+            emitter: emitters,
+            mixture: diffuse && strategy == Strategy::Mixture,
+            bsdf: diffuse && strategy != Strategy::Light,
+            roulette,
         }
-        self.bsdf = sampler.next_2d();
-        self.roulette = sampler.next_1d();
     }
 }
 
@@ -618,6 +670,7 @@ mod tests {
     //! each sample reports is the strategy's pdf at its direction.
     use super::*;
     use crate::light_sampler::{CosineDraws, RectangleDraws, SphereDraws};
+    use lueur_sampling::SamplerKind;
     use lueur_scene::{Camera, Light, QuadSampling, Scene};
     use lueur_stats::DirectionBins;
 
@@ -1021,6 +1074,115 @@ mod tests {
                 |u: &VertexSample| scatter(Strategy::Mixture, &emitters, &v, u, None).map(reported);
             let pdf = |wi| mixture_pdf(&emitters, &v, wi);
             check(&format!("mixture, sky {sky}"), seed, sample, pdf);
+        }
+    }
+
+    /// What [`VertexReads::of`] says a vertex reads is all it reads: numbers it calls
+    /// unread, drawn otherwise, change no direction, weight, pdf or light sample, for
+    /// every strategy, at a diffuse vertex and a mirror, with several emitters and with
+    /// one.
+    #[test]
+    fn numbers_a_vertex_does_not_read_change_nothing() {
+        let mut next = uniforms(11);
+        let one_light = {
+            let camera = Camera::new(Vec3::new(0.0, 1.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0).unwrap();
+            let light = Light::Sphere {
+                center: Vec3::new(-2.0, 3.0, 0.5),
+                radius: 1.0,
+                radiance: Vec3::ONE,
+            };
+            PreparedScene::from(Scene::new(vec![], vec![], vec![light], None, camera).unwrap())
+        };
+        let diffuse = vertex();
+        let mirror = Vertex {
+            material: Material::Mirror {
+                reflectance: Vec3::splat(0.9),
+            },
+            ..diffuse
+        };
+        for scene in [scene(true), one_light] {
+            let emitters = scene.emitters(QuadSampling::SolidAngle);
+            let chooses = emitters.sampler.choice_reads_u();
+            for strategy in Strategy::ALL.iter().copied() {
+                for v in [&diffuse, &mirror] {
+                    let is_diffuse = matches!(v.material, Material::Lambertian { .. });
+                    let reads = VertexReads::of(strategy, is_diffuse, chooses, false);
+                    for _ in 0..200 {
+                        let u = vertex_sample(&mut next);
+                        let other = vertex_sample(&mut next);
+                        let pick = |read: bool, a: f32, b: f32| if read { a } else { b };
+                        let pick2 = |read: bool, a: Vec2, b: Vec2| if read { a } else { b };
+                        let w = VertexSample {
+                            emitter_choice: pick(
+                                reads.emitter_choice,
+                                u.emitter_choice,
+                                other.emitter_choice,
+                            ),
+                            emitter: pick2(reads.emitter, u.emitter, other.emitter),
+                            mixture: pick(reads.mixture, u.mixture, other.mixture),
+                            bsdf: pick2(reads.bsdf, u.bsdf, other.bsdf),
+                            roulette: u.roulette,
+                        };
+                        let what = format!("{strategy:?}, diffuse {is_diffuse}, {reads:?}");
+                        if is_diffuse {
+                            assert_eq!(
+                                scatter(strategy, &emitters, v, &u, None),
+                                scatter(strategy, &emitters, v, &w, None),
+                                "{what}"
+                            );
+                            if uses_next_event(strategy) {
+                                let (p, n) = (v.at.p, v.at.n);
+                                assert_eq!(
+                                    emitters.sample(p, n, u.emitter_choice, u.emitter),
+                                    emitters.sample(p, n, w.emitter_choice, w.emitter),
+                                    "{what}"
+                                );
+                            }
+                        } else {
+                            assert_eq!(mirror_of(v, &u), mirror_of(v, &w), "{what}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn mirror_of(v: &Vertex<'_>, u: &VertexSample) -> Option<Scatter> {
+        mirror(v, u.bsdf)
+    }
+
+    /// [`VertexSample::draw`] draws each number it reads as a draw of every number does,
+    /// whatever it skips, and leaves the others 0: on every sampler kind, at several
+    /// depths and samples.
+    #[test]
+    fn a_vertex_draws_what_it_reads_as_if_it_drew_all() {
+        for &kind in SamplerKind::ALL {
+            for mask in 0..32u32 {
+                let reads = VertexReads {
+                    emitter_choice: mask & 1 != 0,
+                    emitter: mask & 2 != 0,
+                    mixture: mask & 4 != 0,
+                    bsdf: mask & 8 != 0,
+                    roulette: mask & 16 != 0,
+                };
+                let mut all = Sampler::for_render(kind, 5, [8, 8], 16, 4);
+                let mut some = all.clone();
+                for (pixel, index, depth) in [([0, 0], 0, 0), ([3, 5], 7, 2), ([3, 5], 9, 6)] {
+                    let (mut a, mut b) = (VertexSample::UNSET, VertexSample::UNSET);
+                    a.draw(&mut all, pixel, index, depth, VertexReads::ALL);
+                    b.draw(&mut some, pixel, index, depth, reads);
+                    let expect = |read: bool, x: f32| if read { x } else { 0.0 };
+                    let expect2 = |read: bool, x: Vec2| if read { x } else { Vec2::ZERO };
+                    let wanted = VertexSample {
+                        emitter_choice: expect(reads.emitter_choice, a.emitter_choice),
+                        emitter: expect2(reads.emitter, a.emitter),
+                        mixture: expect(reads.mixture, a.mixture),
+                        bsdf: expect2(reads.bsdf, a.bsdf),
+                        roulette: expect(reads.roulette, a.roulette),
+                    };
+                    assert_eq!(b, wanted, "{kind:?}, {reads:?}, depth {depth}");
+                }
+            }
         }
     }
 

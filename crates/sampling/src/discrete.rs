@@ -52,7 +52,8 @@ impl DiscreteDistribution {
     }
 
     /// Draws an index from a uniform `u` in `[0, 1)` and returns it with its
-    /// pmf. Never returns an index of pmf 0.
+    /// pmf. Never returns an index of pmf 0. With one index, `u` is not read
+    /// ([`DiscreteDistribution::reads_u`]).
     pub fn sample(&self, u: f32) -> (usize, f32) {
         // One index (a scene with one light): what the search below finds for every `u`,
         // without it; the renderer asks once or twice per path vertex.
@@ -64,6 +65,12 @@ impl DiscreteDistribution {
         let i = self.cdf[1..].partition_point(|&c| c <= u);
         let i = i.min(self.pmf.len() - 1);
         (i, self.pmf[i])
+    }
+
+    /// Whether [`DiscreteDistribution::sample`] reads its `u`: not with one index, so a
+    /// caller may leave that number undrawn.
+    pub fn reads_u(&self) -> bool {
+        self.pmf.len() > 1
     }
 
     /// Probability of index `i` (0 out of range).
