@@ -113,6 +113,7 @@ pub(crate) struct VertexReads {
 
 impl VertexReads {
     /// Every number.
+    #[cfg(test)]
     pub const ALL: VertexReads = VertexReads {
         emitter_choice: true,
         emitter: true,
