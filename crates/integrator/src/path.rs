@@ -448,8 +448,8 @@ pub(crate) fn radiance_wave(
                 Material::Mirror { .. } => None,
             };
             let diffuse = albedo.is_some();
-            // Roulette may end the path after this vertex, whose depth `scatter` counts.
-            let roulette = path.depth + 1 >= settings.roulette_depth;
+            // `scatter` counts this vertex before its roulette.
+            let roulette = roulette_applies(path.depth + 1, settings.roulette_depth);
             pending.u.draw(
                 &mut s.samplers[i],
                 path.id.pixel,
@@ -647,13 +647,19 @@ fn emission_found(
     }
 }
 
+/// Whether Russian roulette may end a path that has scattered `depth` times (and so
+/// whether its last vertex's roulette number is read).
+fn roulette_applies(depth: u32, roulette_depth: u32) -> bool {
+    depth >= roulette_depth
+}
+
 /// Russian roulette (pbrt-v4 style) after `roulette_depth` scattering
 /// events, on the throughput's largest component: the surviving throughput,
 /// reweighted by `1 / (1 - q)` so that the estimate stays unbiased, or
 /// `None` where the path ends.
 fn roulette(beta: Vec3, depth: u32, roulette_depth: u32, u: f32) -> Option<Vec3> {
     let max_beta = beta.max_element();
-    if depth >= roulette_depth && max_beta < 1.0 {
+    if roulette_applies(depth, roulette_depth) && max_beta < 1.0 {
         let q = (1.0 - max_beta).max(0.0);
         if u < q {
             return None;

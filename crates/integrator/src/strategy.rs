@@ -68,35 +68,38 @@ impl VertexSample {
         reads: VertexReads,
     ) {
         sampler.start_pixel_sample(pixel, index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
-        self.emitter_choice = if reads.emitter_choice {
-            sampler.next_1d()
-        } else {
-            sampler.skip(1);
-            0.0
-        };
-        self.emitter = if reads.emitter {
-            sampler.next_2d()
-        } else {
-            sampler.skip(2);
-            Vec2::ZERO
-        };
-        self.mixture = if reads.mixture {
-            sampler.next_1d()
-        } else {
-            sampler.skip(1);
-            0.0
-        };
-        self.bsdf = if reads.bsdf {
-            sampler.next_2d()
-        } else {
-            sampler.skip(2);
-            Vec2::ZERO
-        };
+        self.emitter_choice = next_1d_read(sampler, reads.emitter_choice);
+        self.emitter = next_2d_read(sampler, reads.emitter);
+        self.mixture = next_1d_read(sampler, reads.mixture);
+        self.bsdf = next_2d_read(sampler, reads.bsdf);
+        // The last number: nothing after it to skip to.
         self.roulette = if reads.roulette {
             sampler.next_1d()
         } else {
             0.0
         };
+    }
+}
+
+/// The sampler's next number where it is `read`; else 0, the number skipped.
+#[inline(always)]
+fn next_1d_read(sampler: &mut Sampler, read: bool) -> f32 {
+    if read {
+        sampler.next_1d()
+    } else {
+        sampler.skip(1);
+        0.0
+    }
+}
+
+/// The sampler's next two numbers where they are `read`; else 0, the numbers skipped.
+#[inline(always)]
+fn next_2d_read(sampler: &mut Sampler, read: bool) -> Vec2 {
+    if read {
+        sampler.next_2d()
+    } else {
+        sampler.skip(2);
+        Vec2::ZERO
     }
 }
 
