@@ -35,32 +35,7 @@ pub fn run(old_path: Option<&Path>, old_rev: Option<&str>) -> Result<()> {
     };
     let new = build_lueur()?;
     let work = cache_dir()?.join("identical");
-    std::fs::create_dir_all(&work).with_context(|| format!("creating {}", work.display()))?;
-    let (old_exr, new_exr) = (work.join("old.exr"), work.join("new.exr"));
-    let (mut same, mut differ) = (0, 0);
-    for scene in shipped_scenes()? {
-        for strategy in STRATEGIES {
-            for naive in [false, true] {
-                for sampler in SAMPLERS {
-                    let args = render_args(&scene, strategy, naive, sampler);
-                    render(&old.binary, &args, &old_exr)?;
-                    render(&new, &args, &new_exr)?;
-                    let shown = args.join(" ");
-                    match compare(&old_exr, &new_exr)? {
-                        None => {
-                            same += 1;
-                            println!("same     {shown}");
-                        }
-                        Some(why) => {
-                            println!("DIFFERS  {shown}: {why}");
-                            differ += 1;
-                        }
-                    }
-                }
-            }
-        }
-    }
-    let _ = std::fs::remove_dir_all(&work);
+    let (same, differ) = compare_builds(&old.binary, &new, &[&[]], &work)?;
     let total = same + differ;
     println!(
         "{same} of {total} renders identical to the old renderer ({})",
@@ -70,6 +45,50 @@ pub fn run(old_path: Option<&Path>, old_rev: Option<&str>) -> Result<()> {
         bail!("{differ} of {total} renders differ from `{}`", old.flag);
     }
     Ok(())
+}
+
+/// Renders every configuration (each shipped scene; `mis` and `mixture`; streamed and
+/// naive; the scene's sampler and independent) with `reference`, then with `other` once
+/// per entry of `variants` (flags added to its command line), and compares each of
+/// `other`'s images with `reference`'s as bits, in the scratch folder `work`. Prints a
+/// line per comparison; returns how many were the same and how many differed.
+pub fn compare_builds(
+    reference: &Path,
+    other: &Path,
+    variants: &[&[&str]],
+    work: &Path,
+) -> Result<(usize, usize)> {
+    std::fs::create_dir_all(work).with_context(|| format!("creating {}", work.display()))?;
+    let (reference_exr, other_exr) = (work.join("reference.exr"), work.join("other.exr"));
+    let (mut same, mut differ) = (0, 0);
+    for scene in shipped_scenes()? {
+        for strategy in STRATEGIES {
+            for naive in [false, true] {
+                for sampler in SAMPLERS {
+                    let args = render_args(&scene, strategy, naive, sampler);
+                    render(reference, &args, &reference_exr)?;
+                    for variant in variants {
+                        let mut args = args.clone();
+                        args.extend(variant.iter().map(|s| s.to_string()));
+                        render(other, &args, &other_exr)?;
+                        let shown = args.join(" ");
+                        match compare(&reference_exr, &other_exr)? {
+                            None => {
+                                same += 1;
+                                println!("same     {shown}");
+                            }
+                            Some(why) => {
+                                println!("DIFFERS  {shown}: {why}");
+                                differ += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(work);
+    Ok((same, differ))
 }
 
 /// The `lueur render` arguments of one comparison, without the output.

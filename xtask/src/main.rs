@@ -1,6 +1,7 @@
 //! `cargo xtask`: lueur's lab bench. Each subcommand regenerates something
 //! under `docs/` from the scene files, deterministically (fixed seeds).
 
+mod aarch64;
 mod compose;
 mod figures;
 mod identical;
@@ -139,6 +140,15 @@ enum Command {
         #[arg(long, value_name = "REV", conflicts_with = "old")]
         old_rev: Option<String>,
     },
+    /// Check that lueur built for aarch64 renders every shipped scene bit for
+    /// bit as this machine's build does, with NEON and scalar streams, under
+    /// qemu (needs the target, gcc-aarch64-linux-gnu and qemu-user); fails
+    /// on any difference.
+    Aarch64 {
+        /// Also run the library tests built for aarch64 under qemu (slow).
+        #[arg(long)]
+        tests: bool,
+    },
     /// Count the instructions lueur executes per sample on each shipped
     /// scene with valgrind's callgrind (the same in every run, unlike times),
     /// against another build where given, and where they go; writes
@@ -188,6 +198,7 @@ fn main() -> Result<()> {
             profile,
         } => speed::run(quick, rounds, old.as_deref(), old_rev.as_deref(), profile),
         Command::Identical { old, old_rev } => identical::run(old.as_deref(), old_rev.as_deref()),
+        Command::Aarch64 { tests } => aarch64::run(tests),
         Command::Instructions {
             quick,
             old,
