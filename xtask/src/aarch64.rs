@@ -15,7 +15,7 @@ use std::process::Command;
 use anyhow::{Context, Result, bail, ensure};
 
 use crate::identical::compare_builds;
-use crate::memory::build_lueur;
+use crate::memory::{build_lueur, cargo, target_dir};
 use crate::project_root;
 use crate::reference::cache_dir;
 
@@ -97,8 +97,7 @@ fn prerequisites() -> Result<()> {
 
 /// Builds `lueur` for the target (release) and returns its path.
 fn build_cross() -> Result<PathBuf> {
-    let target_dir = std::env::var_os("CARGO_TARGET_DIR")
-        .map_or_else(|| project_root().join("target"), PathBuf::from);
+    let target_dir = target_dir();
     let args = [
         "build",
         "--release",
@@ -147,10 +146,6 @@ fn run_tests() -> Result<()> {
     ensure!(status.success(), "{shown} failed");
     println!("the library tests pass on aarch64 (under {QEMU})");
     Ok(())
-}
-
-fn cargo() -> Command {
-    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
 }
 
 #[cfg(unix)]

@@ -157,9 +157,18 @@ pub fn build_lueur() -> Result<PathBuf> {
 
 /// [`build_lueur`] with the optimisation `build`.
 pub fn build_lueur_as(build: Build) -> Result<PathBuf> {
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map_or_else(|| project_root().join("target"), PathBuf::from);
-    build_lueur_from(&project_root(), &target, build, &[])
+    build_lueur_from(&project_root(), &target_dir(), build, &[])
+}
+
+/// This workspace's target directory: `$CARGO_TARGET_DIR` when that is set.
+pub fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(|| project_root().join("target"), PathBuf::from)
+}
+
+/// The cargo that runs xtask (`$CARGO`), or the one on the path.
+pub fn cargo() -> Command {
+    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
 }
 
 /// Builds `lueur` of the workspace at `root` into the target directory `target`
@@ -170,13 +179,12 @@ pub fn build_lueur_from(
     build: Build,
     extra: &[&str],
 ) -> Result<PathBuf> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut args = vec!["build"];
     args.extend(build.args());
     args.extend(["-p", "lueur-cli"]);
     args.extend(extra);
     let shown = format!("cargo {} in {}", args.join(" "), root.display());
-    let status = Command::new(cargo)
+    let status = cargo()
         .args(&args)
         .current_dir(root)
         .env("CARGO_TARGET_DIR", target)
