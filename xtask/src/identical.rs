@@ -121,7 +121,7 @@ fn render(binary: &Path, args: &[String], out: &Path) -> Result<()> {
 
 /// `None` when every channel of every layer of the two files holds the same
 /// bits; otherwise what differs.
-fn compare(a: &Path, b: &Path) -> Result<Option<String>> {
+pub(crate) fn compare(a: &Path, b: &Path) -> Result<Option<String>> {
     let (a, b) = (channels(a)?, channels(b)?);
     if a.keys().ne(b.keys()) {
         return Ok(Some(format!(

@@ -2,6 +2,7 @@
 //! under `docs/` from the scene files, deterministically (fixed seeds).
 
 mod aarch64;
+mod ab;
 mod compose;
 mod figures;
 mod identical;
@@ -149,6 +150,40 @@ enum Command {
         #[arg(long)]
         tests: bool,
     },
+    /// Time this tree against another build on the shipped scenes (issue 18's
+    /// configuration, one thread by default), alternating within each round, and print
+    /// the median ratio of the paired times with a 95% interval and whether the images
+    /// are the same bits. For judging a speed change; writes no report.
+    Ab {
+        /// The other lueur binary.
+        #[arg(long, value_name = "PATH", required_unless_present = "old_rev")]
+        old: Option<PathBuf>,
+        /// The other binary built from this commit (kept under
+        /// target/xtask/old/).
+        #[arg(long, value_name = "REV", conflicts_with = "old")]
+        old_rev: Option<String>,
+        /// A shipped scene to time (repeatable; default: all of them).
+        #[arg(long = "scene", value_name = "NAME")]
+        scenes: Vec<String>,
+        /// Rounds (each times both builds on every scene); 6 at least for an interval.
+        #[arg(long, default_value_t = 11, value_parser = clap::value_parser!(u32).range(1..))]
+        rounds: u32,
+        /// Render threads.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+        threads: u32,
+        /// Image width and height.
+        #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(1..))]
+        size: u32,
+        /// Samples per pixel.
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
+        spp: u32,
+        /// The point set (`lueur render --sampler`).
+        #[arg(long, default_value = "independent")]
+        sampler: String,
+        /// How both are built, as for `speed`.
+        #[arg(long, value_enum, default_value = "release")]
+        profile: memory::Build,
+    },
     /// Count the instructions lueur executes per sample on each shipped
     /// scene with valgrind's callgrind (the same in every run, unlike times),
     /// against another build where given, and where they go; writes
@@ -199,6 +234,29 @@ fn main() -> Result<()> {
         } => speed::run(quick, rounds, old.as_deref(), old_rev.as_deref(), profile),
         Command::Identical { old, old_rev } => identical::run(old.as_deref(), old_rev.as_deref()),
         Command::Aarch64 { tests } => aarch64::run(tests),
+        Command::Ab {
+            old,
+            old_rev,
+            scenes,
+            rounds,
+            threads,
+            size,
+            spp,
+            sampler,
+            profile,
+        } => ab::run(
+            old.as_deref(),
+            old_rev.as_deref(),
+            profile,
+            &ab::Plan {
+                scenes: &scenes,
+                rounds,
+                threads,
+                size,
+                spp,
+                sampler: &sampler,
+            },
+        ),
         Command::Instructions {
             quick,
             old,

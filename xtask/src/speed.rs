@@ -221,7 +221,7 @@ fn time_mitsuba(variant: &str, plan: &Plan, work: &Path) -> Result<f64> {
 }
 
 /// The median, min and max of `xs`, or `None` for none.
-fn spread(xs: &[f64]) -> Option<(f64, f64, f64)> {
+pub(crate) fn spread(xs: &[f64]) -> Option<(f64, f64, f64)> {
     let mut v = xs.to_vec();
     v.sort_by(f64::total_cmp);
     let n = v.len();
@@ -419,7 +419,7 @@ pub(crate) fn cpu_model() -> String {
 }
 
 #[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
-fn simd_features() -> String {
+pub(crate) fn simd_features() -> String {
     let features = [
         ("sse4.2", std::arch::is_x86_feature_detected!("sse4.2")),
         ("avx2", std::arch::is_x86_feature_detected!("avx2")),
@@ -437,13 +437,13 @@ fn simd_features() -> String {
 }
 
 #[cfg(target_arch = "aarch64")]
-fn simd_features() -> String {
+pub(crate) fn simd_features() -> String {
     let neon = std::arch::is_aarch64_feature_detected!("neon");
     format!("aarch64, NEON {}", if neon { "present" } else { "absent" })
 }
 
 #[cfg(not(any(target_arch = "x86", target_arch = "x86_64", target_arch = "aarch64")))]
-fn simd_features() -> String {
+pub(crate) fn simd_features() -> String {
     format!("not probed on {}", std::env::consts::ARCH)
 }
 
