@@ -156,7 +156,8 @@ struct RenderArgs {
     #[arg(long, value_name = "PATHS")]
     wave: Option<usize>,
     /// Stop at this wall-clock budget in seconds: passes of 1, 1, 2, 4, ...
-    /// spp, the last ones cut to what is left (the first always runs).
+    /// spp (none after the first shorter than 0.3 s), the last ones cut to what
+    /// is left (the first always runs).
     #[arg(long, value_name = "SECONDS")]
     time: Option<f64>,
     /// Stop once the image's relative standard error (RMS pixel standard

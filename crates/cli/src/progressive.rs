@@ -1,6 +1,7 @@
 //! Progressive rendering for the CLI: passes of 1, 1, 2, 4, ... samples per
-//! pixel (pbrt's schedule), cut shorter to fit a time budget or a
-//! partial-image interval (the dyadic film adds any range of samples
+//! pixel (pbrt's schedule), none after the first shorter than
+//! [`SHORTEST_PASS_SECONDS`] where a render is fast, cut shorter to fit a time budget
+//! or a partial-image interval (the dyadic film adds any range of samples
 //! exactly), so the film holds a whole number of samples per pixel after
 //! every pass and a render can stop there, on a time budget or an error
 //! target. A signal stops it sooner, after the tiles in flight:
@@ -50,6 +51,10 @@ pub struct Limits {
     /// Passes are cut to take about this long (for `--partial-every`,
     /// which writes the image between passes).
     pub pass_seconds: Option<f64>,
+    /// Whether the film is read after every pass (`--target-error`, `--reference`,
+    /// `--checkpoint`): the passes then keep pbrt's schedule, each doubling the film,
+    /// rather than merging those too short to pay for themselves.
+    pub watched: bool,
 }
 
 /// Why a render stopped.
@@ -90,7 +95,7 @@ pub fn render(
     }
     let resumed_at = film.spp();
     // pbrt's schedule: the first pass brings the film to 1 spp, each next
-    // one doubles it.
+    // one doubles it (or takes at least `SHORTEST_PASS_SECONDS`).
     let mut until = film.samples().end + 1;
     loop {
         let pass_start = Instant::now();
@@ -110,19 +115,10 @@ pub fn render(
         // Seconds per spp: the render's average, or the last pass's if that
         // was slower (what the next pass is likeliest to cost).
         let per_spp = (elapsed / f64::from(done - resumed_at)).max(pass_secs / pass_spp);
-        let mut size = done.max(1).min(end - film.samples().end);
-        if let Some(budget) = limits.time {
-            // The dyadic film takes passes of any size exactly: the last
-            // one is cut to what is left of the budget.
-            let fits = passes_that_fit(budget - elapsed, per_spp);
-            if fits == 0 {
-                return Ok((RenderOutput { film, stats }, Stop::TimeBudget));
-            }
-            size = size.min(fits);
-        }
-        if let Some(seconds) = limits.pass_seconds {
-            size = size.min(passes_that_fit(seconds, per_spp).max(1));
-        }
+        let rest = end - film.samples().end;
+        let Some(size) = next_pass(done, rest, per_spp, elapsed, limits) else {
+            return Ok((RenderOutput { film, stats }, Stop::TimeBudget));
+        };
         if let Some(target) = limits.target_error {
             let reached = film.relative_error();
             if reached <= target {
@@ -131,6 +127,53 @@ pub fn render(
         }
         until = film.samples().end + size;
     }
+}
+
+/// The spp of the next pass, after `done` spp per pixel with `rest` to go, at `per_spp`
+/// seconds each, `elapsed` seconds into the render; `None` where the time budget has no
+/// room for another. The schedule doubles the film, takes at least
+/// [`shortest_pass`] (and all that is left where less than that would be), and is cut to
+/// the time budget's room and to the partial-image interval.
+fn next_pass(done: u32, rest: u32, per_spp: f64, elapsed: f64, limits: Limits) -> Option<u32> {
+    let shortest = shortest_pass(limits, per_spp);
+    let mut size = done.max(1).max(shortest).min(rest);
+    if rest - size < shortest {
+        // What would be left is shorter than a pass worth its costs: take it now.
+        size = rest;
+    }
+    if let Some(budget) = limits.time {
+        // The dyadic film takes passes of any size exactly: the last
+        // one is cut to what is left of the budget.
+        let fits = passes_that_fit(budget - elapsed, per_spp);
+        if fits == 0 {
+            return None;
+        }
+        size = size.min(fits);
+    }
+    if let Some(seconds) = limits.pass_seconds {
+        size = size.min(passes_that_fit(seconds, per_spp).max(1));
+    }
+    Some(size)
+}
+
+/// The shortest pass worth its fixed costs, in seconds. A pass ends when its last tile
+/// does, its tiles are committed to the film one by one, and a tile of a pass of a few
+/// spp holds a wave or two of paths, whose streams run thin as they drain. At 128x128 on
+/// 2 threads, 64 spp in the passes 1, 1, 2, 4, 8, 16, 32 took about 2-3% longer than in
+/// 1 and 63; a floor of 0.1 s (passes 1, 12, 17, 34) bought nothing measurable
+/// (docs/PERFORMANCE.md, "Passes too short to pay for themselves").
+const SHORTEST_PASS_SECONDS: f64 = 0.3;
+
+/// The fewest spp the next pass takes, at `per_spp` seconds each: as many as fill
+/// [`SHORTEST_PASS_SECONDS`], so that a fast render is not cut into passes of a few
+/// milliseconds; none where the film is read between passes ([`Limits::watched`]), which
+/// wants them as the schedule has them. A render longer than that per spp keeps the
+/// schedule.
+fn shortest_pass(limits: Limits, per_spp: f64) -> u32 {
+    if limits.watched {
+        return 0;
+    }
+    passes_that_fit(SHORTEST_PASS_SECONDS, per_spp)
 }
 
 /// How many spp at `per_spp` seconds each fit in `seconds`.
@@ -142,4 +185,64 @@ fn passes_that_fit(seconds: f64, per_spp: f64) -> u32 {
         return u32::MAX;
     }
     (seconds / per_spp).floor().min(f64::from(u32::MAX)) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const NONE: Limits = Limits {
+        time: None,
+        target_error: None,
+        pass_seconds: None,
+        watched: false,
+    };
+
+    /// A render whose spp take milliseconds is not cut into passes of milliseconds; one
+    /// whose spp take a second keeps pbrt's doubling.
+    #[test]
+    fn fast_renders_take_passes_worth_their_costs() {
+        // 5 ms an spp: what is left after the first pass is shorter than a pass.
+        assert_eq!(next_pass(1, 63, 0.005, 0.005, NONE), Some(63));
+        // 30 ms an spp: 10 spp fill the shortest pass.
+        assert_eq!(next_pass(1, 63, 0.03, 0.03, NONE), Some(10));
+        assert_eq!(next_pass(11, 53, 0.03, 0.33, NONE), Some(11));
+        // What a doubling would leave (5 spp, 0.15 s) is taken with it.
+        assert_eq!(next_pass(20, 25, 0.03, 0.6, NONE), Some(25));
+        // A second an spp: the schedule as it was.
+        assert_eq!(next_pass(1, 63, 1.0, 1.0, NONE), Some(1));
+        assert_eq!(next_pass(4, 60, 1.0, 4.0, NONE), Some(4));
+        assert_eq!(next_pass(32, 32, 1.0, 32.0, NONE), Some(32));
+    }
+
+    /// A film read between passes (a target error, a reference, a checkpoint) keeps them
+    /// as the schedule has them.
+    #[test]
+    fn a_watched_film_keeps_the_doubling() {
+        let limits = Limits {
+            watched: true,
+            ..NONE
+        };
+        assert_eq!(next_pass(1, 63, 0.005, 0.005, limits), Some(1));
+        assert_eq!(next_pass(8, 56, 0.005, 0.04, limits), Some(8));
+    }
+
+    /// The time budget and the partial-image interval cut the pass; a budget spent stops.
+    #[test]
+    fn limits_cut_the_pass() {
+        let budget = Limits {
+            time: Some(0.1),
+            ..NONE
+        };
+        // 0.05 s left at 5 ms an spp: 10 spp.
+        assert_eq!(next_pass(1, 63, 0.005, 0.05, budget), Some(10));
+        assert_eq!(next_pass(1, 63, 0.005, 0.1, budget), None);
+        let partial = Limits {
+            pass_seconds: Some(0.02),
+            ..NONE
+        };
+        assert_eq!(next_pass(1, 63, 0.005, 0.005, partial), Some(4));
+        // At least one spp, however long one takes.
+        assert_eq!(next_pass(1, 63, 1.0, 1.0, partial), Some(1));
+    }
 }

@@ -284,15 +284,18 @@ fn execution(args: &RenderArgs) -> Result<Execution> {
 }
 
 /// When to stop or cut passes short: --time, --target-error,
-/// --partial-every (which needs an image to write, `has_out`).
+/// --partial-every (which needs an image to write, `has_out`); and whether the film is
+/// read after every pass (--target-error, --reference, --checkpoint).
 fn render_limits(args: &RenderArgs, has_out: bool) -> Result<progressive::Limits> {
     if args.threads == Some(0) {
         bail!(BadInput("--threads must be at least 1".into()));
     }
+    let target_error = positive(args.target_error, "--target-error")?;
     let limits = progressive::Limits {
         time: positive(args.time, "--time")?,
-        target_error: positive(args.target_error, "--target-error")?,
+        target_error,
         pass_seconds: positive(args.partial_every, "--partial-every")?,
+        watched: target_error.is_some() || args.reference.is_some() || args.checkpoint.is_some(),
     };
     if limits.pass_seconds.is_some() && !has_out {
         bail!(BadInput(
