@@ -928,10 +928,22 @@ mod tests {
                 _ => Sdf::plane(ray.dir.any_orthonormal_vector() * 0.4 - ray.dir, 0.0),
             }
             .translate(center);
-            let (scene, march, Some((s, _))) = shaded_hit(vec![object], &ray, center) else {
+            let (scene, march, Some((s, epsilon))) = shaded_hit(vec![object], &ray, center)
+            else {
                 return Ok(());
             };
             proptest::prop_assume!(!s.inside);
+            if kind == 1 {
+                // The property is the faces'. Within a shell of an edge the normal leans
+                // toward the other face (the field outside a box rounds its crease, and
+                // the differences straddle it), so a ray leaving 3 degrees above that
+                // normal may enter the face it leans from: found at 0.012 of a 62-wide
+                // box's edge (proptest-regressions/surface.txt).
+                let gaps = Vec3::new(1.0, 0.4, 0.7) * size - (s.p - center).abs();
+                let mut gaps = gaps.to_array();
+                gaps.sort_by(f32::total_cmp);
+                proptest::prop_assume!(gaps[1] > 2.0 * epsilon);
+            }
             let frame = lueur_sampling::Frame::from_normal(s.n);
             let mut leaving = Vec::new();
             for cos in [0.05f32, 0.3, 0.7, 1.0] {
