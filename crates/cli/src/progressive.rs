@@ -204,8 +204,9 @@ mod tests {
     fn fast_renders_take_passes_worth_their_costs() {
         // 5 ms an spp: what is left after the first pass is shorter than a pass.
         assert_eq!(next_pass(1, 63, 0.005, 0.005, NONE), Some(63));
-        // 30 ms an spp: 10 spp fill the shortest pass.
-        assert_eq!(next_pass(1, 63, 0.03, 0.03, NONE), Some(10));
+        // 3/128 s an spp (exact in binary, so the floor of 0.3 / it is not a rounding
+        // away from another count): 12 spp fill the shortest pass.
+        assert_eq!(next_pass(1, 63, 0.0234375, 0.0234375, NONE), Some(12));
         assert_eq!(next_pass(11, 53, 0.03, 0.33, NONE), Some(11));
         // What a doubling would leave (5 spp, 0.15 s) is taken with it.
         assert_eq!(next_pass(20, 25, 0.03, 0.6, NONE), Some(25));
