@@ -654,6 +654,8 @@ mod tests {
     use lueur_materials::Material;
     use lueur_scene::{Camera, Light, Object, Scene};
     use lueur_sdf_math::{Sdf, TraceOutcome, position_rounding};
+    use proptest::prelude::{ProptestConfig, TestCaseError, prop_assert, prop_assume};
+    use proptest::test_runner::RngSeed;
 
     /// A march with the default thresholds.
     fn march(central_normals: bool) -> March {
@@ -894,8 +896,110 @@ mod tests {
         (scene, march, shaded)
     }
 
+    /// The property of [`rays_leaving_a_tightly_bound_object_are_clipped_away_from_it`], for
+    /// one draw of its inputs: rejected where the draw is outside what it claims.
+    fn check_rays_leaving(
+        kind: u8,
+        size_exp: f32,
+        far: f32,
+        [cx, cy, cz]: [f32; 3],
+        (theta, phi): (f32, f32),
+        aim: f32,
+        phase: f32,
+    ) -> Result<(), TestCaseError> {
+        let size = 10f32.powf(size_exp);
+        // Up to 2000 sizes from the origin, and 1e3.
+        let center = (Vec3::new(cx, cy, cz) * size * 10f32.powf(far)).clamp_length_max(1e3);
+        prop_assume!(0.3 * size >= 1e3 * position_rounding(center));
+        let ray = ray_at(center, size, theta, phi, aim);
+        let object = match kind {
+            0 => Sdf::sphere(size),
+            1 => Sdf::cuboid(Vec3::new(1.0, 0.4, 0.7) * size),
+            _ => Sdf::plane(ray.dir.any_orthonormal_vector() * 0.4 - ray.dir, 0.0),
+        }
+        .translate(center);
+        let (scene, march, Some((s, epsilon))) = shaded_hit(vec![object], &ray, center) else {
+            return Ok(());
+        };
+        prop_assume!(!s.inside);
+        if kind == 1 {
+            // The property is the faces'. Within a shell of an edge the normal leans
+            // toward the other face (the field outside a box rounds its crease, and
+            // the differences straddle it), so a ray leaving 3 degrees above that
+            // normal may enter the face it leans from: found at 0.012 of a 62-wide
+            // box's edge (`a_ray_leaving_a_box_near_its_edge`).
+            let gaps = Vec3::new(1.0, 0.4, 0.7) * size - (s.p - center).abs();
+            let mut gaps = gaps.to_array();
+            gaps.sort_by(f32::total_cmp);
+            prop_assume!(gaps[1] > 2.0 * epsilon);
+        }
+        let frame = lueur_sampling::Frame::from_normal(s.n);
+        let mut leaving = Vec::new();
+        for cos in [0.05f32, 0.3, 0.7, 1.0] {
+            for k in 0..4 {
+                let a = phase + k as f32 * std::f32::consts::FRAC_PI_2;
+                let sin = (1.0 - cos * cos).sqrt();
+                let local = Vec3::new(sin * a.cos(), sin * a.sin(), cos);
+                leaving.push(Ray::new(s.origin, frame.to_world(local).normalize()));
+            }
+        }
+        for level in SimdLevel::available() {
+            let mut batch = crate::geometry::MarchBatch::default();
+            for (i, r) in leaving.iter().enumerate() {
+                batch.queue(i, *r, march.secondary.resolving(r.origin));
+            }
+            scene.geometry.march(level, &mut batch);
+            for (i, outcome, _) in batch.results() {
+                prop_assert!(
+                    outcome == TraceOutcome::Miss { steps: 0 },
+                    "{level:?}: ray {i} leaving kind {kind} at {:?} (normal {:?}, \
+                     {} above the surface) along {:?}: {outcome:?}",
+                    s.p,
+                    s.n,
+                    (s.origin - s.p).length(),
+                    leaving[i].dir
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// The case proptest found in CI when this test drew a fresh seed each run: a hit on
+    /// the -x face of a box 62 across, 0.012 from its +z edge, where the normal leans
+    /// toward +z, and a ray leaving 3 degrees above it enters the -x face again. It lies
+    /// in the shell of the edge that the property leaves out; without that exclusion it
+    /// fails.
+    #[test]
+    fn a_ray_leaving_a_box_near_its_edge() {
+        let result = check_rays_leaving(
+            1,
+            1.7910755,
+            0.0,
+            [0.0; 3],
+            (1.8324265, 5.678609),
+            0.05349786,
+            0.0,
+        );
+        if let Err(TestCaseError::Fail(why)) = result {
+            panic!("{why}");
+        }
+    }
+
+    /// Proptest's configuration here, as in the workspace's other property tests: a fixed
+    /// seed, so that a failure reproduces on every machine and CI fails on a change, never
+    /// on a case no earlier run drew; and no regression files (a case worth keeping becomes
+    /// a test of its own, as above).
+    fn config(cases: u32) -> ProptestConfig {
+        ProptestConfig {
+            cases,
+            rng_seed: RngSeed::Fixed(0x0073_7572_6661_6365),
+            failure_persistence: None,
+            ..ProptestConfig::default()
+        }
+    }
+
     proptest::proptest! {
-        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(512))]
+        #![proptest_config(config(512))]
 
         /// A ray leaving an object whose bound is the object itself is clipped away from
         /// it before its first step: a sphere (its own sphere), a box (its own box), a
@@ -917,58 +1021,7 @@ mod tests {
             aim in -0.45f32..0.45,
             phase in 0.0f32..std::f32::consts::TAU,
         ) {
-            let size = 10f32.powf(size_exp);
-            // Up to 2000 sizes from the origin, and 1e3.
-            let center = (Vec3::new(cx, cy, cz) * size * 10f32.powf(far)).clamp_length_max(1e3);
-            proptest::prop_assume!(0.3 * size >= 1e3 * position_rounding(center));
-            let ray = ray_at(center, size, theta, phi, aim);
-            let object = match kind {
-                0 => Sdf::sphere(size),
-                1 => Sdf::cuboid(Vec3::new(1.0, 0.4, 0.7) * size),
-                _ => Sdf::plane(ray.dir.any_orthonormal_vector() * 0.4 - ray.dir, 0.0),
-            }
-            .translate(center);
-            let (scene, march, Some((s, epsilon))) = shaded_hit(vec![object], &ray, center)
-            else {
-                return Ok(());
-            };
-            proptest::prop_assume!(!s.inside);
-            if kind == 1 {
-                // The property is the faces'. Within a shell of an edge the normal leans
-                // toward the other face (the field outside a box rounds its crease, and
-                // the differences straddle it), so a ray leaving 3 degrees above that
-                // normal may enter the face it leans from: found at 0.012 of a 62-wide
-                // box's edge (proptest-regressions/surface.txt).
-                let gaps = Vec3::new(1.0, 0.4, 0.7) * size - (s.p - center).abs();
-                let mut gaps = gaps.to_array();
-                gaps.sort_by(f32::total_cmp);
-                proptest::prop_assume!(gaps[1] > 2.0 * epsilon);
-            }
-            let frame = lueur_sampling::Frame::from_normal(s.n);
-            let mut leaving = Vec::new();
-            for cos in [0.05f32, 0.3, 0.7, 1.0] {
-                for k in 0..4 {
-                    let a = phase + k as f32 * std::f32::consts::FRAC_PI_2;
-                    let sin = (1.0 - cos * cos).sqrt();
-                    let local = Vec3::new(sin * a.cos(), sin * a.sin(), cos);
-                    leaving.push(Ray::new(s.origin, frame.to_world(local).normalize()));
-                }
-            }
-            for level in SimdLevel::available() {
-                let mut batch = crate::geometry::MarchBatch::default();
-                for (i, r) in leaving.iter().enumerate() {
-                    batch.queue(i, *r, march.secondary.resolving(r.origin));
-                }
-                scene.geometry.march(level, &mut batch);
-                for (i, outcome, _) in batch.results() {
-                    proptest::prop_assert!(
-                        outcome == TraceOutcome::Miss { steps: 0 },
-                        "{level:?}: ray {i} leaving kind {kind} at {:?} (normal {:?}, \
-                         {} above the surface) along {:?}: {outcome:?}",
-                        s.p, s.n, (s.origin - s.p).length(), leaving[i].dir
-                    );
-                }
-            }
+            check_rays_leaving(kind, size_exp, far, [cx, cy, cz], (theta, phi), aim, phase)?;
         }
 
         /// At any hit, the ray leaving the surface starts no higher above it than a small
