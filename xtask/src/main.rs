@@ -12,6 +12,7 @@ mod old;
 mod peers;
 mod plot;
 mod pointset_figures;
+mod properties;
 mod reference;
 mod replicates;
 mod report;
@@ -200,6 +201,18 @@ enum Command {
         #[arg(long, value_name = "REV", conflicts_with = "old")]
         old_rev: Option<String>,
     },
+    /// Run the workspace's property tests under other seeds than their own
+    /// (`PROPTEST_RNG_SEED` = FIRST, FIRST + 1, ...), to find claims that fail on cases
+    /// their fixed seeds never draw; prints each failure with its seed and minimal input,
+    /// and fails if there is one. Writes no report.
+    Properties {
+        /// The first seed.
+        #[arg(long, default_value_t = 1)]
+        first: u64,
+        /// How many seeds, each a run of every property test (about 10 s).
+        #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u64).range(1..))]
+        count: u64,
+    },
     /// Run a command and print its peak resident set in kB (used by
     /// `memory`, one process per measurement).
     #[command(hide = true)]
@@ -262,6 +275,7 @@ fn main() -> Result<()> {
             old,
             old_rev,
         } => instructions::run(quick, old.as_deref(), old_rev.as_deref()),
+        Command::Properties { first, count } => properties::run(first, count),
         Command::MemoryProbe { command } => memory::probe(&command),
     }
 }
