@@ -1298,7 +1298,14 @@ mod relaxed {
         })
     }
 
-    /// Both tracers agree: both hit on one piece of surface, or both miss.
+    /// Whether the ray past `t` stays outside the surface at 4096 points up to `t_max`, so
+    /// that a hit at `t` was only the hit threshold's.
+    fn only_grazes(sdf: &Sdf, ray: &Ray, t: f32, p: &TraceParams) -> bool {
+        (0..=4096).all(|i| sdf.distance(ray.at(t + (p.t_max - t) * (i as f32 / 4096.0))) > 0.0)
+    }
+
+    /// Both tracers agree: both hit on one piece of surface, or both miss, or the plain
+    /// tracer hits where the ray only grazes a surface.
     fn agree(sdf: &Sdf, ray: &Ray, p: &TraceParams) -> Result<(), TestCaseError> {
         let plain = sphere_trace(sdf, ray, p);
         let relaxed = sphere_trace_relaxed(sdf, ray, p, OVER_RELAXATION);
@@ -1314,6 +1321,12 @@ mod relaxed {
                 );
             }
             (TraceOutcome::Miss { .. }, TraceOutcome::Miss { .. }) => {}
+            // A ray that only grazes a surface, never going below it, is a hit where it
+            // passes within the hit threshold, which grows with `t`: where the gap and the
+            // threshold meet, one tracer may stop and the other, stepping to other points,
+            // pass. A ray that goes below the surface may not be missed.
+            (TraceOutcome::Hit { t: tp, .. }, TraceOutcome::Miss { .. })
+                if only_grazes(sdf, ray, tp, p) => {}
             // Running out of steps is slow, not wrong, as long as it stopped short.
             (TraceOutcome::Hit { t: tp, .. }, TraceOutcome::GaveUp { t: tr, .. }) => {
                 prop_assert!(
@@ -1372,15 +1385,7 @@ mod relaxed {
             lift in -2e-3f32..2e-3,
             angle in 0f32..std::f32::consts::TAU,
         ) {
-            let (shape, _) = thin(kind, 0.0, 0.0);
-            let sdf = shape.rotate(turn).scale(scale);
-            // Start outside, 3 units away in the plate's plane, heading through (x, y).
-            let dir = Vec3::new(angle.cos(), angle.sin(), 0.0);
-            let target = Vec3::new(x, y, lift);
-            let origin = target - dir * 3.0;
-            let ray = Ray::new(turn * origin * scale, turn * dir);
-            prop_assume!(sdf.distance(ray.origin) > 0.0);
-            agree(&sdf, &ray, &params(scale))?;
+            check_edge_on(kind, turn, scale, Vec3::new(x, y, lift), angle)?;
         }
 
         /// Random rays at random unions (the shapes an integrator traces).
@@ -1403,6 +1408,40 @@ mod relaxed {
                 let ray = Ray::new(origin, c + aim * r - origin);
                 agree(&sdf, &ray, &params(r))?;
             }
+        }
+    }
+
+    /// The property of `edge_on`: a thin shape `kind` turned by `turn` and scaled, the ray
+    /// in its plane at `angle` through `target` (its `z` the lift off the plane).
+    fn check_edge_on(
+        kind: u8,
+        turn: Quat,
+        scale: f32,
+        target: Vec3,
+        angle: f32,
+    ) -> Result<(), TestCaseError> {
+        let (shape, _) = thin(kind, 0.0, 0.0);
+        let sdf = shape.rotate(turn).scale(scale);
+        // Start outside, 3 units away in the plate's plane, heading through the target.
+        let dir = Vec3::new(angle.cos(), angle.sin(), 0.0);
+        let origin = target - dir * 3.0;
+        let ray = Ray::new(turn * origin * scale, turn * dir);
+        prop_assume!(sdf.distance(ray.origin) > 0.0);
+        agree(&sdf, &ray, &params(scale))
+    }
+
+    /// A case `cargo xtask properties` found under seed 68: a plate 670 wide and 0.67
+    /// thick, the ray 0.017 under its face along it. The hit threshold grows with `t`
+    /// (1e-5 t) and meets the gap at t = 1684, where the plain tracer stops after 17940
+    /// steps and the relaxed one, stepping to other points, passes and misses. The ray
+    /// never goes below the surface, so both are right.
+    #[test]
+    fn a_ray_grazing_a_plate_where_the_threshold_meets_the_gap() {
+        let turn = Quat::from_xyzw(-0.12222462, -0.05549896, -0.0063540847, 0.9909292);
+        let target = Vec3::new(-1.2707547, -0.9616983, -0.0010502412);
+        if let Err(TestCaseError::Fail(why)) = check_edge_on(1, turn, 335.41394, target, 1.3268073)
+        {
+            panic!("{why}");
         }
     }
 
