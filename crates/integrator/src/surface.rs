@@ -964,11 +964,10 @@ mod tests {
         Ok(())
     }
 
-    /// The case proptest found in CI when this test drew a fresh seed each run: a hit on
-    /// the -x face of a box 62 across, 0.012 from its +z edge, where the normal leans
-    /// toward +z, and a ray leaving 3 degrees above it enters the -x face again. It lies
-    /// in the shell of the edge that the property leaves out; without that exclusion it
-    /// fails.
+    /// A case proptest found: a hit on the -x face of a box 62 across, 0.012 from its +z
+    /// edge, where the normal leans toward +z, and a ray leaving 3 degrees above it enters
+    /// the -x face again. It lies in the shell of the edge that the property leaves out;
+    /// without that exclusion it fails.
     #[test]
     fn a_ray_leaving_a_box_near_its_edge() {
         let result = check_rays_leaving(

@@ -198,8 +198,8 @@ fn check_sphere_light(
 /// A case a run with another seed found: a light 1e-4 across at coordinates near 2, the
 /// point on its surface (`factor` 1) but rounded to 1.5e-7 outside it, less than a
 /// rounding of its coordinates (2.4e-7). The cone's axis then lands on the point itself,
-/// and there is no direction to sample. Before the rounding term above, the property
-/// claimed a sample there.
+/// and there is no direction to sample. Without the rounding term above, the property
+/// would claim one there.
 #[test]
 fn a_point_on_a_tiny_light_rounded_outside_it() {
     let dir = Vec3::new(-0.1380665, -0.9669317, 0.21443152);
