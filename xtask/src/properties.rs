@@ -24,11 +24,14 @@ pub fn run(first: u64, count: u64) -> Result<()> {
     for p in &packages {
         args.extend(["-p".into(), p.clone()]);
     }
+    let cargo_test = || {
+        let mut command = Command::new(env!("CARGO"));
+        command.args(&args).current_dir(&root);
+        command
+    };
     eprintln!("properties: building the tests of {}", packages.join(", "));
-    let status = Command::new(env!("CARGO"))
-        .args(&args)
+    let status = cargo_test()
         .arg("--no-run")
-        .current_dir(&root)
         .status()
         .context("cannot run cargo")?;
     if !status.success() {
@@ -36,11 +39,9 @@ pub fn run(first: u64, count: u64) -> Result<()> {
     }
     let mut failures = Vec::new();
     for seed in first..first.saturating_add(count) {
-        let out = Command::new(env!("CARGO"))
-            .args(&args)
+        let out = cargo_test()
             .arg("--no-fail-fast")
             .env("PROPTEST_RNG_SEED", seed.to_string())
-            .current_dir(&root)
             .output()
             .context("cannot run cargo test")?;
         let text = String::from_utf8_lossy(&out.stdout).into_owned()

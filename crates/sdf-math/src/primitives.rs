@@ -434,14 +434,15 @@ fn death_star<L: Lane>(p: LaneVec3<L>, ra: f32, rb: f32, d: f32) -> L {
     // star keeps the plain difference: its rounding is then the star's own, and a division
     // less.
     let large_bite = rb > 4.0 * ra;
+    let plain = L::splat(rb) - to_bite;
     let small = if large_bite {
         let x = q.x;
         let numerator = (L::splat(d + rb) - x) * (x - L::splat(d - rb)) - q.y * q.y;
         let stable = numerator / (L::splat(rb) + to_bite);
         // Far points (an infinite coordinate) take the plain difference, exact there.
-        L::select(stable.finite(), stable, L::splat(rb) - to_bite)
+        L::select(stable.finite(), stable, plain)
     } else {
-        L::splat(rb) - to_bite
+        plain
     };
     if death_star_kind(ra, rb, d) != DeathStarKind::Rim {
         return big.max(small);
