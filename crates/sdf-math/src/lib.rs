@@ -70,7 +70,7 @@ pub use crate::lanes::{
     Neon, Portable, SimdLevel, Sse, Task, UnavailableLevel, Wide,
 };
 pub use crate::normal::{
-    FALLBACK_NORMAL, Tetrahedron, gradient, gradient_central, gradient_lanes, normal,
+    Central, FALLBACK_NORMAL, Tetrahedron, gradient, gradient_central, gradient_lanes, normal,
     normal_central,
 };
 pub use crate::prepared::PreparedSdf;

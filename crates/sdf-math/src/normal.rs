@@ -107,18 +107,80 @@ impl<L: Lane> Tetrahedron<L> {
         let c2 = LaneVec3::new(t0.z, t1.z, t2.z);
         c0 * rises.x + c1 * rises.y + c2 * rises.z
     }
+
+    /// The field's Laplacian from the values `f` at the points and `centre` at `p`:
+    /// `sum_i f(p + h k_i) - 4 f(p) = 2 h^2 (Laplacian) + O(h^3)`, since the `k_i` sum to 0
+    /// and `sum_i k_i k_i^T = 4 I`. A rough estimate (`h` from the points' spread), for
+    /// telling where the surface curves on the scale of the step.
+    #[inline(always)]
+    pub fn laplacian(&self, f: [L; 4], centre: L) -> L {
+        // |k_0 - k_3|^2 = 8.
+        let h2 = (self.0[0] - self.0[3]).length_squared() * L::splat(0.125);
+        (f[0] + f[1] + f[2] + f[3] - L::splat(4.0) * centre) / (L::splat(2.0) * h2)
+    }
 }
 
 /// The gradient by central differences (6 evaluations), not normalised: the naive
 /// reference for [`gradient`], with the same treatment of `h` and the same caveat.
 pub fn gradient_central<F: DistanceField + ?Sized>(field: &F, p: Vec3, h: f32) -> Vec3 {
-    let h = usable_step(LaneVec3::from(p), h);
-    // Divided by the distance between the points actually sampled (see [`gradient`]).
-    let d = |e: Vec3| {
-        let (a, b) = (p + e * h, p - e * h);
-        (field.distance(a) - field.distance(b)) / (a - b).dot(e)
-    };
-    Vec3::new(d(Vec3::X), d(Vec3::Y), d(Vec3::Z))
+    let c = Central::around(LaneVec3::from(p), h);
+    Vec3::from(c.gradient(c.points().map(|x| field.distance(Vec3::from(x)))))
+}
+
+/// The six points central differences sample around a point (one per lane), and the
+/// gradient and Laplacian they give: the stencil of [`gradient_central`], for a caller
+/// that evaluates the points as it likes (see [`Tetrahedron`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Central<L = f32>([LaneVec3<L>; 6]);
+
+impl<L: Lane> Central<L> {
+    /// The points `p +- h e` for each axis `e`, with `h` made usable at `p`.
+    #[inline(always)]
+    pub fn around(p: LaneVec3<L>, h: L) -> Central<L> {
+        let h = usable_step(p, h);
+        let (x, y, z) = (
+            LaneVec3::splat(Vec3::X) * h,
+            LaneVec3::splat(Vec3::Y) * h,
+            LaneVec3::splat(Vec3::Z) * h,
+        );
+        Central([p + x, p - x, p + y, p - y, p + z, p - z])
+    }
+
+    /// The points to evaluate the field at: `+x, -x, +y, -y, +z, -z`.
+    #[inline(always)]
+    pub fn points(&self) -> [LaneVec3<L>; 6] {
+        self.0
+    }
+
+    /// Each axis's difference of the values `f` at the points, over the distance between
+    /// the points actually sampled (see [`Tetrahedron::gradient`]).
+    #[inline(always)]
+    pub fn gradient(&self, f: [L; 6]) -> LaneVec3<L> {
+        let q = self.0;
+        LaneVec3::new(
+            (f[0] - f[1]) / (q[0].x - q[1].x),
+            (f[2] - f[3]) / (q[2].y - q[3].y),
+            (f[4] - f[5]) / (q[4].z - q[5].z),
+        )
+    }
+
+    /// The field's Laplacian from the values `f` at the points and `centre` at `p`: the
+    /// second differences along the three axes, summed.
+    #[inline(always)]
+    pub fn laplacian(&self, f: [L; 6], centre: L) -> L {
+        let q = self.0;
+        second_difference(f[0], f[1], centre, q[0].x - q[1].x)
+            + second_difference(f[2], f[3], centre, q[2].y - q[3].y)
+            + second_difference(f[4], f[5], centre, q[4].z - q[5].z)
+    }
+}
+
+/// `(f(p + s/2) + f(p - s/2) - 2 f(p)) / (s/2)^2` from the values and the span `s`. Not a
+/// closure: it would be compiled apart from a vector kernel's features.
+#[inline(always)]
+fn second_difference<L: Lane>(plus: L, minus: L, centre: L, span: L) -> L {
+    let half = span * L::splat(0.5);
+    (plus + minus - L::splat(2.0) * centre) / (half * half)
 }
 
 /// Central differences (6 evaluations), kept as the naive reference for [`normal`].
