@@ -805,6 +805,65 @@ mod tests {
         }
     }
 
+    /// A scene of white objects seen by `camera`.
+    fn white_scene(objects: Vec<Sdf>, camera: Camera) -> PreparedScene {
+        let objects = (objects.into_iter())
+            .map(|sdf| Object { sdf, material: 0 })
+            .collect();
+        let white = Material::Lambertian { albedo: Vec3::ONE };
+        Scene::new(objects, vec![white], vec![], None, camera)
+            .unwrap()
+            .into()
+    }
+
+    /// The march of the default settings in `marching`.
+    fn march_in(scene: &PreparedScene, marching: Marching) -> March {
+        let settings = RenderSettings {
+            marching,
+            ..RenderSettings::default()
+        };
+        March::new(scene, &settings)
+    }
+
+    /// Shades `hits` alone, then in streams of each length in `lens` on every level this
+    /// CPU has, and fails unless the streams give each hit's bits alone. Returns the hits
+    /// shaded alone.
+    fn shade_alone_and_in_streams(
+        scene: &PreparedScene,
+        march: &March,
+        hits: &[(Ray, SurfaceHit)],
+        lens: &[usize],
+    ) -> Vec<SurfacePoint> {
+        let alone: Vec<SurfacePoint> = hits
+            .iter()
+            .map(|(ray, hit)| SurfacePoint::at_hit(scene, march, ray, *hit))
+            .collect();
+        let bits = |s: &SurfacePoint| {
+            [s.p, s.n, s.origin]
+                .map(|v| v.to_array().map(f32::to_bits))
+                .concat()
+        };
+        for level in SimdLevel::available() {
+            for &len in lens {
+                let mut scratch = SurfaceScratch::default();
+                let mut streamed = Vec::new();
+                for (chunk, expected) in hits.chunks(len).zip(alone.chunks(len)) {
+                    SurfacePoint::at_hits(scene, march, level, chunk, &mut scratch, &mut streamed);
+                    assert_eq!(streamed.len(), chunk.len());
+                    for (k, (a, b)) in streamed.iter().zip(expected).enumerate() {
+                        assert!(
+                            bits(a) == bits(b) && a.inside == b.inside,
+                            "{:?}, {level:?}, streams of {len}, hit {k}: {a:?} streamed, \
+                             {b:?} alone",
+                            march.marching
+                        );
+                    }
+                }
+            }
+        }
+        alone
+    }
+
     /// The stream of shading points gives, on every level this CPU has, the bits of each
     /// hit shaded alone: hits on five objects (rotated, scaled, a smooth blend) from
     /// camera rays that cross them head-on, obliquely and grazing, in groups whose sizes
@@ -830,19 +889,11 @@ mod tests {
             ),
             Sdf::cuboid(Vec3::new(8.0, 0.1, 8.0)).translate(Vec3::new(0.0, -2.0, 0.0)),
         ]
-        .map(|sdf| Object { sdf, material: 0 })
         .to_vec();
-        let white = Material::Lambertian { albedo: Vec3::ONE };
         let camera = Camera::new(Vec3::new(0.3, 0.4, 6.0), Vec3::ZERO, Vec3::Y, 50.0).unwrap();
-        let scene: PreparedScene = Scene::new(objects, vec![white], vec![], None, camera)
-            .unwrap()
-            .into();
+        let scene = white_scene(objects, camera);
         for marching in [Marching::Fast, Marching::Naive] {
-            let settings = RenderSettings {
-                marching,
-                ..RenderSettings::default()
-            };
-            let march = March::new(&scene, &settings);
+            let march = march_in(&scene, marching);
             let mut hits = Vec::new();
             let mut counters = crate::TraceCounters::default();
             for i in 0..61 {
@@ -868,40 +919,8 @@ mod tests {
             let objects_hit: std::collections::HashSet<usize> =
                 hits.iter().map(|(_, hit)| hit.object).collect();
             assert_eq!(objects_hit.len(), 5, "every object is hit");
-            let alone: Vec<SurfacePoint> = hits
-                .iter()
-                .map(|(ray, hit)| SurfacePoint::at_hit(&scene, &march, ray, *hit))
-                .collect();
-            let bits = |s: &SurfacePoint| {
-                [s.p, s.n, s.origin]
-                    .map(|v| v.to_array().map(f32::to_bits))
-                    .concat()
-            };
-            for level in SimdLevel::available() {
-                // Whole streams, and streams cut so that groups end part-way through vectors.
-                for len in [hits.len(), 37, 5, 1] {
-                    let mut scratch = SurfaceScratch::default();
-                    let mut streamed = Vec::new();
-                    for (chunk, expected) in hits.chunks(len).zip(alone.chunks(len)) {
-                        SurfacePoint::at_hits(
-                            &scene,
-                            &march,
-                            level,
-                            chunk,
-                            &mut scratch,
-                            &mut streamed,
-                        );
-                        assert_eq!(streamed.len(), chunk.len());
-                        for (k, (a, b)) in streamed.iter().zip(expected).enumerate() {
-                            assert!(
-                                bits(a) == bits(b) && a.inside == b.inside,
-                                "{marching:?}, {level:?}, streams of {len}, hit {k}: \
-                                 {a:?} streamed, {b:?} alone"
-                            );
-                        }
-                    }
-                }
-            }
+            // Whole streams, and streams cut so that groups end part-way through vectors.
+            shade_alone_and_in_streams(&scene, &march, &hits, &[hits.len(), 37, 5, 1]);
         }
     }
 
@@ -916,25 +935,14 @@ mod tests {
     /// (0.0035 at worst).
     #[test]
     fn a_thin_tube_on_a_large_ring_has_unbiased_normals() {
-        let white = Material::Lambertian { albedo: Vec3::ONE };
         for radius in [1.0f32, 10.0, 100.0, 1000.0] {
             let centre = Vec3::new(0.0, 0.0, -radius);
             let torus = Sdf::torus(radius, 0.1).translate(centre);
-            let objects = vec![Object {
-                sdf: torus,
-                material: 0,
-            }];
             let eye = Vec3::new(0.0, 0.5, 3.0);
             let camera = Camera::new(eye, Vec3::ZERO, Vec3::Y, 40.0).unwrap();
-            let scene: PreparedScene = Scene::new(objects, vec![white], vec![], None, camera)
-                .unwrap()
-                .into();
+            let scene = white_scene(vec![torus], camera);
             for marching in [Marching::Fast, Marching::Naive] {
-                let settings = RenderSettings {
-                    marching,
-                    ..RenderSettings::default()
-                };
-                let march = March::new(&scene, &settings);
+                let march = march_in(&scene, marching);
                 let mut counters = crate::TraceCounters::default();
                 // Rays from 3 away at heights across the tube and along it, as camera rays
                 // (a shell 1e-3 wide) and as secondary rays (1e-4).
@@ -950,10 +958,7 @@ mod tests {
                     }
                 }
                 assert!(hits.len() >= 100, "{radius}: {} hits", hits.len());
-                let alone: Vec<SurfacePoint> = hits
-                    .iter()
-                    .map(|(ray, hit)| SurfacePoint::at_hit(&scene, &march, ray, *hit))
-                    .collect();
+                let alone = shade_alone_and_in_streams(&scene, &march, &hits, &[hits.len()]);
                 for s in &alone {
                     // The exact normal: away from the ring's nearest point, in f64.
                     let p = (s.p - centre).as_dvec3();
@@ -972,29 +977,6 @@ mod tests {
                         s.n,
                         s.p
                     );
-                }
-                let bits = |s: &SurfacePoint| {
-                    [s.p, s.n, s.origin]
-                        .map(|v| v.to_array().map(f32::to_bits))
-                        .concat()
-                };
-                for level in SimdLevel::available() {
-                    let mut scratch = SurfaceScratch::default();
-                    let mut streamed = Vec::new();
-                    SurfacePoint::at_hits(
-                        &scene,
-                        &march,
-                        level,
-                        &hits,
-                        &mut scratch,
-                        &mut streamed,
-                    );
-                    for (k, (a, b)) in streamed.iter().zip(&alone).enumerate() {
-                        assert!(
-                            bits(a) == bits(b),
-                            "{marching:?}, {level:?}, ring {radius}, hit {k}: {a:?} streamed, {b:?} alone"
-                        );
-                    }
                 }
             }
         }
@@ -1042,14 +1024,8 @@ mod tests {
     ) -> (PreparedScene, March, Option<(SurfacePoint, f32)>) {
         let camera =
             Camera::new(ray.origin, look_at, ray.dir.any_orthonormal_vector(), 40.0).unwrap();
-        let objects = (objects.into_iter())
-            .map(|sdf| Object { sdf, material: 0 })
-            .collect();
-        let white = Material::Lambertian { albedo: Vec3::ONE };
-        let scene: PreparedScene = Scene::new(objects, vec![white], vec![], None, camera)
-            .unwrap()
-            .into();
-        let march = March::new(&scene, &RenderSettings::default());
+        let scene = white_scene(objects, camera);
+        let march = march_in(&scene, Marching::Fast);
         let mut counters = crate::TraceCounters::default();
         let shaded = match scene.intersect(ray, &march.secondary, march.marching, &mut counters) {
             Some(Hit::Surface {
