@@ -456,3 +456,76 @@ fn camera_pixel_of(camera: &Camera, p: Vec3, width: u32, height: u32) -> (u32, u
     }
     best.1
 }
+
+/// A mirror tube 0.1 thick on a ring up to a kilometre in radius, its near side under the
+/// camera, and a small sphere light above: the scene is symmetric about x = 0, so the
+/// light's reflection in the tube is centred in the image, and at radii of 100 and more
+/// it carries about what a straight tube's does. Near the tube the ring's field rounds at
+/// its radius, which sets the difference step of normals: at radius 1e3 it was 0.06, and
+/// the tetrahedron then tilted the normals along the tube, which put the reflection 20
+/// pixels off centre (6 at radius 100) with 48% more energy.
+///
+/// **Confidence.** The reflection is some 100 samples that hit the light, so its energy is
+/// noisy, but the ring and the straight tube share their samples. Over seeds 0-7 the
+/// centroid stayed within 0.25 pixels of the centre and the energy within 4.3% of the
+/// straight tube's; the test allows 1 pixel and 10%. Fixed seed.
+#[test]
+fn a_mirror_tube_on_a_kilometre_ring_reflects_its_light_where_it_should() {
+    let (width, height) = (128u32, 128u32);
+    let camera = Camera::new(
+        Vec3::new(0.0, 0.5, 3.0),
+        Vec3::new(0.0, 0.2, 0.0),
+        Vec3::Y,
+        40.0,
+    )
+    .unwrap();
+    let light = Light::Sphere {
+        center: Vec3::new(0.0, 2.0, 0.5),
+        radius: 0.1,
+        radiance: Vec3::splat(100.0),
+    };
+    let settings = RenderSettings {
+        width,
+        height,
+        spp: 64,
+        strategy: Strategy::Mis,
+        sampler: SamplerKind::Stratified,
+        max_depth: 1,
+        ..Default::default()
+    };
+    // The reflection's pixels (the rest of the image is black), their centroid's column
+    // and their sum.
+    let reflection = |tube: Sdf| {
+        let mirror = Material::Mirror {
+            reflectance: Vec3::splat(0.9),
+        };
+        let scene = crate::common::scene_of(vec![tube], mirror, vec![light], None, camera);
+        let film = run(&scene, &settings).film;
+        let (mut sum, mut moment) = (0.0f64, 0.0f64);
+        for y in 0..height {
+            for x in 0..width {
+                let v = f64::from(film.pixel(x, y).mean.y);
+                sum += v;
+                moment += v * (f64::from(x) + 0.5);
+            }
+        }
+        (moment / sum, sum)
+    };
+    let centre = f64::from(width) / 2.0;
+    // A straight tube 6 long, whose field rounds at its own size: the ring's reflection,
+    // less the ring's curvature.
+    let straight = Sdf::capsule(Vec3::new(-3.0, 0.2, 0.0), Vec3::new(3.0, 0.2, 0.0), 0.1);
+    let (_, expected) = reflection(straight);
+    for radius in [100.0f32, 1000.0] {
+        let ring = Sdf::torus(radius, 0.1).translate(Vec3::new(0.0, 0.2, -radius));
+        let (column, energy) = reflection(ring);
+        assert!(
+            (column - centre).abs() < 1.0,
+            "ring {radius}: the reflection is centred on column {column}, not {centre}"
+        );
+        assert!(
+            (energy / expected - 1.0).abs() < 0.1,
+            "ring {radius}: the reflection's energy is {energy}, {expected} on a straight tube"
+        );
+    }
+}
