@@ -284,6 +284,43 @@ mod tests {
         }
     }
 
+    /// Both stencils' Laplacians: 0 on a linear field, and `2 / r` on a sphere's field at
+    /// its surface (the sum of its principal curvatures), for radii 1e-2 to 1e2 at a step
+    /// of 1e-2 of the radius.
+    #[test]
+    fn both_laplacians_read_a_spheres_curvature_and_a_planes_none() {
+        struct Ball(f32);
+        impl DistanceField for Ball {
+            fn distance(&self, p: Vec3) -> f32 {
+                p.length() - self.0
+            }
+            fn lipschitz(&self) -> f32 {
+                1.0
+            }
+        }
+        fn laplacians<F: DistanceField>(field: &F, p: Vec3, h: f32) -> [f32; 2] {
+            let at = LaneVec3::from(p);
+            let centre = field.distance(p);
+            let values = |q: LaneVec3<f32>| field.distance(Vec3::from(q));
+            let t = Tetrahedron::around(at, h);
+            let c = Central::around(at, h);
+            [
+                t.laplacian(t.points().map(values), centre),
+                c.laplacian(c.points().map(values), centre),
+            ]
+        }
+        let plane = Linear(Vec3::new(0.36, -0.48, 0.8));
+        for lap in laplacians(&plane, Vec3::new(0.3, 0.2, 0.1), 1e-2) {
+            assert!(lap.abs() < 1e-2, "plane: {lap}");
+        }
+        for r in [1e-2f32, 1.0, 1e2] {
+            let p = Vec3::new(0.48, 0.6, 0.64) * r;
+            for lap in laplacians(&Ball(r), p, 1e-2 * r) {
+                assert!((lap * r / 2.0 - 1.0).abs() < 0.01, "radius {r}: {lap}");
+            }
+        }
+    }
+
     /// A sphere of radius 50 about 1e4 from the origin, where f32 positions are 1e-3 apart:
     /// at a step of eight roundings the sample points are off their intended offsets by up
     /// to 6% of the step, which dividing by the intended offsets turns into a normal off
