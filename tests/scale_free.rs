@@ -529,3 +529,120 @@ fn a_mirror_tube_on_a_kilometre_ring_reflects_its_light_where_it_should() {
         );
     }
 }
+
+/// A floor 2 km wide, seen from half a metre above it out to the horizon, under a sphere
+/// light 0.1 in radius: with one scattering event the radiance at a floor point is
+/// `albedo L (r / d)^2 (h / d)` (the light's irradiance `pi L sin^2`, its cosine `h / d`,
+/// times `albedo / pi`), which each row's mean must match, integrated over the pixels'
+/// footprints, from 3.5 m out to 25 m.
+///
+/// The tracer stops where a camera ray enters its shell, a sixteenth of a pixel's footprint
+/// above the floor, which at slope `s` is `1/s` times that before the ray crosses it. The
+/// shading point was taken along the normal from there wherever the ray met the floor at
+/// less than 14.5 degrees: the floor shifted by a sixteenth of a pixel toward the horizon,
+/// and came out 1.5% too bright at 4 m and 10.5% at 14-22 m at this image size, every row
+/// beyond 70 standard errors (at 128x128, 3.5% at 15 m). Now the Newton step along the ray
+/// moves the point to the crossing down to slopes of 1/1024.
+///
+/// **Confidence.** `light` sampling of one sphere light with stratified samples: each
+/// row's mean has a standard error of about 1e-4 of it. A row fails where it misses the
+/// closed form by more than 4 standard errors *and* by more than 0.2% (the
+/// closed form is integrated over each pixel on a 32x32 grid, whose error is below 1e-4
+/// on these rows). Measured: every row within 0.22% and 2.1 standard errors.
+#[test]
+fn a_floor_seen_at_grazing_angles_keeps_its_closed_form() {
+    let (width, height) = (48u32, 48u32);
+    let camera = Camera::new(
+        Vec3::new(0.0, 0.5, 3.0),
+        Vec3::new(0.0, 0.2, 0.0),
+        Vec3::Y,
+        40.0,
+    )
+    .unwrap();
+    let (center, radius, radiance) = (Vec3::new(0.0, 2.0, 0.5), 0.1f32, 100.0f32);
+    let floor = Sdf::cuboid(Vec3::new(1000.0, 0.05, 1000.0)).translate(Vec3::new(0.0, -0.05, 0.0));
+    let material = Material::Lambertian {
+        albedo: Vec3::splat(ALBEDO),
+    };
+    let light = Light::Sphere {
+        center,
+        radius,
+        radiance: Vec3::splat(radiance),
+    };
+    let objects = vec![Object {
+        sdf: floor,
+        material: 0,
+    }];
+    let scene = Scene::new(objects, vec![material], vec![light], None, camera).unwrap();
+    let settings = RenderSettings {
+        width,
+        height,
+        spp: 64,
+        strategy: Strategy::Light,
+        sampler: SamplerKind::Stratified,
+        max_depth: 1,
+        seed: 5,
+        ..Default::default()
+    };
+    let film = run(&scene, &settings).film;
+
+    // Where a camera ray meets the floor (y = 0), if it does.
+    let floor_t = |film_pos: Vec2| -> Option<(f64, [f64; 3])> {
+        let ray = camera.generate_ray(film_pos, width, height);
+        let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3().normalize());
+        (d.y < 0.0).then(|| {
+            let t = -o.y / d.y;
+            let p = o + d * t;
+            (t, p.to_array())
+        })
+    };
+    let closed_form = |p: [f64; 3]| {
+        let to_light = center.as_dvec3() - glam::DVec3::from_array(p);
+        let d = to_light.length();
+        let r = f64::from(radius);
+        f64::from(ALBEDO * radiance) * (r / d).powi(2) * (to_light.y / d)
+    };
+    let grid = 32;
+    let (mut checked, mut wrong) = (0, Vec::new());
+    for y in 0..height {
+        // Rows whose footprints lie on the floor between 3.5 and 25 m away.
+        let near = floor_t(Vec2::new(0.0, y as f32 + 1.0)).map(|(t, _)| t);
+        let far = floor_t(Vec2::new(0.0, y as f32)).map(|(t, _)| t);
+        let (Some(near), Some(far)) = (near, far) else {
+            continue;
+        };
+        if near < 3.5 || far > 25.0 {
+            continue;
+        }
+        let mut expected = 0.0;
+        for x in 0..width {
+            for i in 0..grid * grid {
+                let (u, v) = ((i % grid) as f32 + 0.5, (i / grid) as f32 + 0.5);
+                let at = Vec2::new(x as f32 + u / grid as f32, y as f32 + v / grid as f32);
+                expected += floor_t(at).map_or(0.0, |(_, p)| closed_form(p));
+            }
+        }
+        let n = f64::from(width);
+        expected /= n * f64::from(grid * grid);
+        let mean = (0..width)
+            .map(|x| f64::from(film.pixel(x, y).mean.y))
+            .sum::<f64>()
+            / n;
+        let stderr = ((0..width)
+            .map(|x| f64::from(film.pixel(x, y).variance_of_mean().y))
+            .sum::<f64>()
+            / (n * n))
+            .sqrt();
+        let error = (mean - expected) / expected;
+        checked += 1;
+        if (mean - expected).abs() > 4.0 * stderr && error.abs() > 2e-3 {
+            wrong.push(format!(
+                "row {y} ({near:.1}-{far:.1} m): {mean} +- {stderr}, expected {expected} \
+                 ({:+.3}%)",
+                100.0 * error
+            ));
+        }
+    }
+    assert!(wrong.is_empty(), "{wrong:#?}");
+    assert!(checked >= 8, "{checked} rows checked");
+}

@@ -8,7 +8,7 @@ use lueur_sdf_math::{
     Lane, LaneDistance, LaneKernel, LaneVec3, MAX_LANES, PreparedSdf, Ray, SimdLevel, Tetrahedron,
 };
 
-use super::{Approach, HitPrecision, March, Projection, Start, SurfaceHit, SurfacePoint};
+use super::{Approach, HitPrecision, March, Newton, Projection, SurfaceHit, SurfacePoint};
 use crate::PreparedScene;
 
 impl SurfacePoint {
@@ -93,8 +93,9 @@ impl SurfaceScratch {
 enum Round<L: Lane> {
     /// At the hit and ahead of it.
     Start,
-    /// Around the start, for its normal, and at the start.
-    Normal(Start<L>, Tetrahedron<L>),
+    /// Around the Newton step's candidate, for its normal, and at the candidate; the
+    /// field at the hit.
+    Normal(Newton<L>, Tetrahedron<L>, L),
     /// At the point projected along the normal.
     Projection(Projection<L>),
 }
@@ -103,7 +104,8 @@ enum Round<L: Lane> {
 /// [`SurfacePoint::new`] on a vector of hits at a time, a hit per lane, with the field
 /// values they ask for evaluated as vectors (7, and an 8th where some lane's point
 /// moves along the normal). A hit whose surface curves on the scale of the step
-/// ([`Approach::curved`]) is shaded again alone.
+/// ([`Approach::curved`]), or whose grazing Newton step the field or the gradient refused
+/// ([`Approach::start`], [`Approach::stencil_refuses`]), is shaded again alone.
 struct HitsOnObject<'a> {
     sdf: &'a PreparedSdf,
     march: &'a March,
@@ -167,30 +169,38 @@ impl LaneKernel for HitsOnObject<'_> {
             let mut values = [L::splat(0.0); 5];
             let mut count = 2;
             let mut round = Round::Start;
-            // The lanes whose surface curves on the scale of the step: shaded again alone
-            // below (`SurfacePoint::new`, the same bits), so that the rare case costs the
-            // vector loop no state.
-            let mut curved = 0;
+            // The lanes whose surface curves on the scale of the step, or whose grazing
+            // Newton step was refused: shaded again alone below (`SurfacePoint::new`, the
+            // same bits), so that the rare cases cost the vector loop no state.
+            let mut redo = 0;
             let (projection, f_p) = loop {
                 for (value, &point) in values.iter_mut().zip(&points).take(count) {
                     *value = sdf.distance_lanes(point);
                 }
                 round = match round {
                     Round::Start => {
-                        let start = approach.start(values[0], values[1]);
-                        let tetrahedron = Tetrahedron::around(start.point, approach.h);
+                        let newton = approach.newton(values[0], values[1]);
+                        let tetrahedron = Tetrahedron::around(newton.point, approach.h);
                         let [q0, q1, q2, q3] = tetrahedron.points();
-                        points = [q0, q1, q2, q3, start.point];
+                        points = [q0, q1, q2, q3, newton.point];
                         count = 5;
-                        Round::Normal(start, tetrahedron)
+                        Round::Normal(newton, tetrahedron, values[0])
                     }
-                    Round::Normal(start, tetrahedron) => {
+                    Round::Normal(newton, tetrahedron, f_hit) => {
+                        // The candidate is the start in every lane but those whose grazing
+                        // step the field or the gradient refused, which are shaded again
+                        // alone.
+                        let (start, f_start, refused, grazing) =
+                            approach.start(&newton, f_hit, values[4]);
                         let f = [values[0], values[1], values[2], values[3]];
                         let grad = tetrahedron.gradient(f);
-                        curved = L::bits(approach.curved(tetrahedron.laplacian(f, values[4])).0);
-                        let projection = approach.project(start, grad, values[4]);
+                        let (is_curved, _) = approach.curved(tetrahedron.laplacian(f, f_start));
+                        let refused =
+                            L::or(refused, approach.stencil_refuses(&newton, grazing, grad));
+                        redo = L::bits(L::or(is_curved, refused));
+                        let projection = approach.project(start, grad, f_start);
                         if !L::any(projection.moved) {
-                            break (projection, values[4]);
+                            break (projection, f_start);
                         }
                         // A lane that did not move has its start as `p`, and evaluating it
                         // again gives `f_start`'s bits.
@@ -210,7 +220,7 @@ impl LaneKernel for HitsOnObject<'_> {
             }
             let inside = L::bits(s.inside);
             for (j, &k) in chunk.iter().enumerate() {
-                if curved >> j & 1 != 0 {
+                if redo >> j & 1 != 0 {
                     let (ray, hit) = &self.hits[k as usize];
                     self.out[k as usize] = SurfacePoint::shaded_alone(sdf, ray, hit, self.march);
                     continue;
