@@ -5,7 +5,8 @@
 //! sees a small patch right below the light, where the closed form holds; every
 //! strategy's patch mean is compared with it. Then how far that holds (floors to 1e7, the
 //! scene moved to 1e6), thin features far from their own frame (a mirror tube on rings of
-//! radius 1 to 1e4), and what giving up at the step cap costs. Writes docs/SCALE.md.
+//! radius 1 to 1e4), a floor seen at grazing angles out to the horizon, and what giving up
+//! at the step cap costs. Writes docs/SCALE.md.
 
 use std::fmt::Write as _;
 
@@ -279,6 +280,7 @@ pub fn run(quick: bool) -> Result<()> {
         range(&mut out, spp)?;
     }
     curved(&mut out, quick)?;
+    horizon(&mut out, quick)?;
     give_ups(&mut out, quick)?;
     let dir = docs_dir(quick);
     std::fs::create_dir_all(&dir)?;
@@ -416,6 +418,132 @@ fn curved(out: &mut String, quick: bool) -> Result<()> {
             "| ring of radius {r:e} | {rounding:.1e} | {} |",
             cells.join(" | ")
         );
+    }
+    out.push('\n');
+    Ok(())
+}
+
+/// A floor 2 km wide seen from half a metre above it out to the horizon, under a sphere
+/// light 0.1 in radius, against the closed form `albedo L (r / d)^2 (h / d)` integrated
+/// over each pixel: camera rays meet the floor at slopes down to the horizon's, where the
+/// tracer stops `1/s` shells before the crossing, and the shading point must still be
+/// there. A floor 0.1 thick, and one 1 mm thick, thinner than the difference step of
+/// normals far out.
+fn horizon(out: &mut String, quick: bool) -> Result<()> {
+    let (size, spp) = (128u32, if quick { 16 } else { 256 });
+    let _ = writeln!(
+        out,
+        "## A floor to the horizon\n\nA Lambertian floor (albedo {ALBEDO}) 2 km wide, its \
+         top at y = 0, seen from 0.5 above it (looking 5.7 degrees down, 40-degree field, \
+         the horizon 17 rows above the centre) under a sphere light of radius 0.1 and \
+         radiance 100 at height 2; {size}x{size}, {spp} spp, `light`, `stratified`, \
+         `max_depth = 1`, seed 0. A camera ray meets the floor at slope `s` (the sine of its \
+         angle to it, 0.1 at 5 m, 0.01 at 50 m); the tracer stops where it enters its \
+         shell, a sixteenth of a pixel's footprint above the floor, `1/s` shells before it \
+         crosses. Each cell: the mean over the rows whose footprints lie in the distance \
+         band, relative to the closed form integrated over each pixel (16x16 points), and \
+         its z-score.\n\n| floor | distance | closed form | fast | naive |\n|---|---|---|---|---|"
+    );
+    let bands = [
+        (3.5, 5.0),
+        (5.0, 10.0),
+        (10.0, 20.0),
+        (20.0, 40.0),
+        (40.0, 1000.0),
+    ];
+    let (eye, look_at) = ([0.0f32, 0.5, 3.0], [0.0f32, 0.2, 0.0]);
+    let (center, radius, radiance) = ([0.0f64, 2.0, 0.5], 0.1f64, 100.0f64);
+    for (label, thickness) in [("0.1 thick", 0.1f64), ("1 mm thick", 1e-3)] {
+        let text = format!(
+            "[camera]\nposition = {eye:?}\nlook_at = {look_at:?}\nvfov = 40.0\n\
+             [materials]\nwhite = {{ type = \"lambertian\", albedo = [{ALBEDO:?}, {ALBEDO:?}, {ALBEDO:?}] }}\n\
+             [[objects]]\nmaterial = \"white\"\nshape = {{ type = \"box\", center = [0.0, {:e}, 0.0], \
+             half_extents = [1000.0, {:e}, 1000.0] }}\n\
+             [[lights]]\ntype = \"sphere\"\ncenter = {center:?}\nradius = {radius:?}\n\
+             radiance = [{radiance:?}, {radiance:?}, {radiance:?}]\n",
+            -thickness / 2.0,
+            thickness / 2.0
+        );
+        let file = parse_scene(&text, "horizon.toml").context("the generated scene")?;
+        let camera = file.scene.camera;
+        let films = [Marching::Fast, Marching::Naive]
+            .into_iter()
+            .map(|marching| {
+                let settings = RenderSettings {
+                    width: size,
+                    height: size,
+                    spp,
+                    strategy: Strategy::Light,
+                    sampler: SamplerKind::Stratified,
+                    max_depth: 1,
+                    seed: 0,
+                    marching,
+                    ..file.settings.clone()
+                };
+                render_with_bar(&file.scene, &settings, &format!("horizon {marching:?}"))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        // Where a camera ray through `film` meets the floor, if it does.
+        let floor_t = |x: f32, y: f32| {
+            let ray = camera.generate_ray(glam::Vec2::new(x, y), size, size);
+            let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3().normalize());
+            (d.y < 0.0).then(|| (-o.y / d.y, o + d * (-o.y / d.y)))
+        };
+        let closed_form = |p: glam::DVec3| {
+            let to_light = glam::DVec3::from_array(center) - p;
+            let d = to_light.length();
+            ALBEDO * radiance * (radius / d).powi(2) * (to_light.y / d)
+        };
+        for (near, far) in bands {
+            let rows: Vec<u32> = (0..size)
+                .filter(|&y| {
+                    let top = floor_t(0.0, y as f32).map(|(t, _)| t);
+                    let bottom = floor_t(0.0, y as f32 + 1.0).map(|(t, _)| t);
+                    matches!((bottom, top), (Some(b), Some(t)) if b >= near && t <= far)
+                })
+                .collect();
+            if rows.is_empty() {
+                continue;
+            }
+            let grid = 16u32;
+            let mut expected = 0.0;
+            for &y in &rows {
+                for x in 0..size {
+                    for i in 0..grid * grid {
+                        let (u, v) = ((i % grid) as f32 + 0.5, (i / grid) as f32 + 0.5);
+                        let (fx, fy) = (x as f32 + u / grid as f32, y as f32 + v / grid as f32);
+                        expected += floor_t(fx, fy).map_or(0.0, |(_, p)| closed_form(p));
+                    }
+                }
+            }
+            let n = (rows.len() * size as usize) as f64;
+            expected /= n * f64::from(grid * grid);
+            let cells = films
+                .iter()
+                .map(|film| {
+                    let (mut mean, mut var) = (0.0, 0.0);
+                    for &y in &rows {
+                        for x in 0..size {
+                            let p = film.pixel(x, y);
+                            mean += f64::from(p.mean.y);
+                            var += f64::from(p.variance_of_mean().y);
+                        }
+                    }
+                    let (mean, stderr) = (mean / n, var.sqrt() / n);
+                    format!(
+                        "{:+.3}% (z {:+.1})",
+                        100.0 * (mean / expected - 1.0),
+                        (mean - expected) / stderr
+                    )
+                })
+                .collect::<Vec<_>>();
+            let _ = writeln!(
+                out,
+                "| {label} | {near}-{far} m ({} rows) | {expected:.4e} | {} |",
+                rows.len(),
+                cells.join(" | ")
+            );
+        }
     }
     out.push('\n');
     Ok(())
