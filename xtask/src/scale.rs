@@ -442,7 +442,9 @@ fn horizon(out: &mut String, quick: bool) -> Result<()> {
          shell, a sixteenth of a pixel's footprint above the floor, `1/s` shells before it \
          crosses. Each cell: the mean over the rows whose footprints lie in the distance \
          band, relative to the closed form integrated over each pixel (16x16 points), and \
-         its z-score.\n\n| floor | distance | closed form | fast | naive |\n|---|---|---|---|---|"
+         its z-score. Naive marching takes every step the field allows, with no bounds to \
+         clip to: past 40 m its camera rays reach the step cap (`max_steps`) short of the \
+         floor and are shaded where they stopped.\n\n| floor | distance | closed form | fast | naive |\n|---|---|---|---|---|"
     );
     let bands = [
         (3.5, 5.0),
