@@ -457,6 +457,31 @@ fn camera_pixel_of(camera: &Camera, p: Vec3, width: u32, height: u32) -> (u32, u
     best.1
 }
 
+/// Half a metre above the floor, looking 5.7 degrees down over it: the view of the mirror
+/// tube and of the floor seen to the horizon.
+fn low_camera() -> Camera {
+    Camera::new(
+        Vec3::new(0.0, 0.5, 3.0),
+        Vec3::new(0.0, 0.2, 0.0),
+        Vec3::Y,
+        40.0,
+    )
+    .unwrap()
+}
+
+/// The small sphere light above [`low_camera`]'s view.
+const SMALL_LIGHT_CENTER: Vec3 = Vec3::new(0.0, 2.0, 0.5);
+const SMALL_LIGHT_RADIUS: f32 = 0.1;
+const SMALL_LIGHT_RADIANCE: f32 = 100.0;
+
+fn small_light() -> Light {
+    Light::Sphere {
+        center: SMALL_LIGHT_CENTER,
+        radius: SMALL_LIGHT_RADIUS,
+        radiance: Vec3::splat(SMALL_LIGHT_RADIANCE),
+    }
+}
+
 /// A mirror tube 0.1 thick on a ring up to a kilometre in radius, its near side under the
 /// camera, and a small sphere light above: the scene is symmetric about x = 0, so the
 /// light's reflection in the tube is centred in the image, and at radii of 100 and more
@@ -472,18 +497,8 @@ fn camera_pixel_of(camera: &Camera, p: Vec3, width: u32, height: u32) -> (u32, u
 #[test]
 fn a_mirror_tube_on_a_kilometre_ring_reflects_its_light_where_it_should() {
     let (width, height) = (128u32, 128u32);
-    let camera = Camera::new(
-        Vec3::new(0.0, 0.5, 3.0),
-        Vec3::new(0.0, 0.2, 0.0),
-        Vec3::Y,
-        40.0,
-    )
-    .unwrap();
-    let light = Light::Sphere {
-        center: Vec3::new(0.0, 2.0, 0.5),
-        radius: 0.1,
-        radiance: Vec3::splat(100.0),
-    };
+    let camera = low_camera();
+    let light = small_light();
     let settings = RenderSettings {
         width,
         height,
@@ -552,23 +567,13 @@ fn a_mirror_tube_on_a_kilometre_ring_reflects_its_light_where_it_should() {
 #[test]
 fn a_floor_seen_at_grazing_angles_keeps_its_closed_form() {
     let (width, height) = (48u32, 48u32);
-    let camera = Camera::new(
-        Vec3::new(0.0, 0.5, 3.0),
-        Vec3::new(0.0, 0.2, 0.0),
-        Vec3::Y,
-        40.0,
-    )
-    .unwrap();
-    let (center, radius, radiance) = (Vec3::new(0.0, 2.0, 0.5), 0.1f32, 100.0f32);
+    let camera = low_camera();
+    let (center, radius, radiance) = (SMALL_LIGHT_CENTER, SMALL_LIGHT_RADIUS, SMALL_LIGHT_RADIANCE);
     let floor = Sdf::cuboid(Vec3::new(1000.0, 0.05, 1000.0)).translate(Vec3::new(0.0, -0.05, 0.0));
     let material = Material::Lambertian {
         albedo: Vec3::splat(ALBEDO),
     };
-    let light = Light::Sphere {
-        center,
-        radius,
-        radiance: Vec3::splat(radiance),
-    };
+    let light = small_light();
     let objects = vec![Object {
         sdf: floor,
         material: 0,
