@@ -68,13 +68,18 @@ impl Default for RenderSettings {
             roulette_depth: 3,
             seed: 0,
             max_steps: 256,
-            // A sixteenth of a pixel: a ray that passes this close to a
-            // surface is a hit, so silhouettes grow by this much. At a
-            // quarter pixel they grew visibly against Mitsuba's exact
-            // intersections (24 of 3072 8x8-pixel region-channels beyond
-            // 4 sigma at 1024 spp, all on silhouettes and grazing corners;
-            // none at a sixteenth: docs/PEERS.md), for no measurable time.
-            pixel_epsilon: 0.0625,
+            // A 64th of a pixel: a ray that passes this close to a surface
+            // is a hit, so silhouettes and convex creases grow by this
+            // much. At a quarter pixel they grew visibly against Mitsuba's
+            // exact intersections (24 of 3072 8x8-pixel region-channels
+            // beyond 4 sigma at 1024 spp, all on silhouettes and grazing
+            // corners; none at a sixteenth: docs/PEERS.md). At a sixteenth
+            // the Death Star's rim pixels were still up to 2.6 times too
+            // bright against a shell of 1/1000 (333 of 16384 pixels beyond
+            // 2%, the image mean +0.086%); at a 64th, 66 pixels and +0.021%
+            // (the bias is linear in the shell), for no measurable time
+            // (0.98, 0.99, 1.01 of a sixteenth's on the shipped scenes).
+            pixel_epsilon: 0.015625,
             epsilon_rel: 1e-4,
             marching: Marching::default(),
             quad_sampling: QuadSampling::default(),

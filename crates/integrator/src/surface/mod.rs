@@ -194,7 +194,7 @@ impl<L: Lane> HitPrecision<L> {
 }
 
 /// A hit made usable for shading: the tracer stops anywhere in a shell of
-/// width `epsilon` around the surface (a sixteenth of a pixel for camera
+/// width `epsilon` around the surface (a 64th of a pixel for camera
 /// rays, by default), so
 /// shading there would measure light from the wrong point. One Newton step
 /// *along the ray* moves the point onto the surface where the ray crosses
@@ -366,9 +366,10 @@ impl<L: Lane> Approach<L> {
     /// rounding an offset covers), which one step does on a plane at any slope: the
     /// tracer stops where the ray enters its shell, an `epsilon` above the surface, which
     /// along a ray at slope `s` is `epsilon / s` before the crossing; taken along the
-    /// normal instead, the point stayed there, a sixteenth of a pixel's footprint nearer
-    /// the camera, and a floor under a small light came out 3.5% too bright 15 m away,
-    /// 9% at 43 m. [`Approach::stencil_refuses`] may still refuse a kept step.
+    /// normal instead, the point stays there, `pixel_epsilon` of a pixel's footprint
+    /// nearer the camera (at a sixteenth, a floor under a small light came out 3.5% too
+    /// bright 15 m away, 9% at 43 m). [`Approach::stencil_refuses`] may still refuse a
+    /// kept step.
     #[inline(always)]
     fn start(&self, newton: &Newton<L>, f_hit: L, f_point: L) -> (Start<L>, L, L::Mask, L::Mask) {
         let converged = (f_hit.abs() * L::splat(0.25))
@@ -711,9 +712,9 @@ mod tests {
     /// below 1/8, within a fifth of the way from where the tracer stopped (the slope's
     /// rounding over the difference step, about 1e-3, is a few percent of a slope of
     /// 1/64). Taken along the normal from where the tracer stopped, as it was below a
-    /// slope of 1/4, the point stayed all that way nearer the camera: a sixteenth of a
-    /// pixel's footprint, which made a floor under a small light 3.5% too bright 15 m
-    /// from the camera.
+    /// slope of 1/4, the point stayed all that way nearer the camera: with camera shells
+    /// of a sixteenth of a pixel, a floor under a small light came out 3.5% too bright
+    /// 15 m from the camera.
     #[test]
     fn a_grazing_ray_s_shading_point_is_where_it_crosses_the_surface() {
         let epsilon = 1e-3f32;
