@@ -360,8 +360,9 @@ impl<L: Lane> Approach<L> {
     }
 
     /// The start, from the candidate of [`Approach::newton`] and the field there
-    /// (`f_point`; at the hit, `f_hit`), with the field at the start, the lanes whose
-    /// grazing candidate was refused, and those where it was kept. A grazing step is kept
+    /// (`f_point`; at the hit, `f_hit`), with the field at the start and the lanes whose
+    /// grazing candidate was kept (the others of `newton.grazing` were refused). A grazing
+    /// step is kept
     /// where it took the field to a quarter of its value at the hit or below (or to the
     /// rounding an offset covers), which one step does on a plane at any slope: the
     /// tracer stops where the ray enters its shell, an `epsilon` above the surface, which
@@ -371,18 +372,17 @@ impl<L: Lane> Approach<L> {
     /// bright 15 m away, 9% at 43 m). [`Approach::stencil_refuses`] may still refuse a
     /// kept step.
     #[inline(always)]
-    fn start(&self, newton: &Newton<L>, f_hit: L, f_point: L) -> (Start<L>, L, L::Mask, L::Mask) {
+    fn start(&self, newton: &Newton<L>, f_hit: L, f_point: L) -> (Start<L>, L, L::Mask) {
         let converged = (f_hit.abs() * L::splat(0.25))
             .max(self.spawn_floor)
             .ge(f_point.abs());
         let grazing = L::and(newton.grazing, converged);
         let taken = L::or(newton.steep, grazing);
-        let refused = L::and(newton.grazing, L::not(converged));
         let start = Start {
             point: select(taken, newton.point, self.hit),
             on_ray: newton.steep,
         };
-        (start, L::select(taken, f_point, f_hit), refused, grazing)
+        (start, L::select(taken, f_point, f_hit), grazing)
     }
 
     /// The lanes whose kept grazing step (`grazing`) the gradient at its point, `grad`,
@@ -536,7 +536,7 @@ impl SurfacePoint {
         let f_hit = sdf.distance(hit);
         let field = |q: LaneVec3<f32>| sdf.distance(Vec3::from(q));
         let newton = approach.newton(f_hit, field(approach.ahead));
-        let (start, f_start, _, grazing) = approach.start(&newton, f_hit, field(newton.point));
+        let (start, f_start, grazing) = approach.start(&newton, f_hit, field(newton.point));
         let at_hit = Start {
             point: approach.hit,
             on_ray: false,

@@ -190,13 +190,14 @@ impl LaneKernel for HitsOnObject<'_> {
                         // The candidate is the start in every lane but those whose grazing
                         // step the field or the gradient refused, which are shaded again
                         // alone.
-                        let (start, f_start, refused, grazing) =
-                            approach.start(&newton, f_hit, values[4]);
+                        let (start, f_start, grazing) = approach.start(&newton, f_hit, values[4]);
                         let f = [values[0], values[1], values[2], values[3]];
                         let grad = tetrahedron.gradient(f);
                         let (is_curved, _) = approach.curved(tetrahedron.laplacian(f, f_start));
-                        let refused =
-                            L::or(refused, approach.stencil_refuses(&newton, grazing, grad));
+                        let refused = L::or(
+                            L::and(newton.grazing, L::not(grazing)),
+                            approach.stencil_refuses(&newton, grazing, grad),
+                        );
                         redo = L::bits(L::or(is_curved, refused));
                         let projection = approach.project(start, grad, f_start);
                         if !L::any(projection.moved) {
