@@ -69,7 +69,10 @@ impl March {
         let camera = TraceParams {
             t_min: 0.0,
             t_max: FAR_LIMIT * scene.scale(),
-            max_steps: settings.max_steps,
+            max_steps: match settings.marching {
+                Marching::Fast => settings.max_steps,
+                Marching::Naive => settings.max_steps.saturating_mul(NAIVE_STEPS),
+            },
             eps_abs: 0.0,
             eps_rel: settings.pixel_epsilon * scene.scene().camera.pixel_angle(settings.height),
         };
@@ -86,6 +89,19 @@ impl March {
         }
     }
 }
+
+/// Naive marching takes this many times `max_steps`. A ray that reaches the cap is taken
+/// as a hit where it stopped: right for a ray crawling along a wall it is about to meet,
+/// wrong for one crawling away from a large plane at a shallow angle, which sphere tracing
+/// moves `1 + sin(angle)` times farther a step, and which then misses the sky behind it.
+/// Fast marching clips such rays away from the plane's bound; naive marching, with no
+/// bounds, gave up on 0.3% of the bounce rays off an open floor at a cap of 256 (the floor
+/// under a sky came out 0.064% too dark, z -42, against its exact closed form), and its
+/// image means were off those of a cap of 65536 by +0.017% (cornell), +0.12% (Death Star)
+/// and +0.028% (donut-mirrors). The angles left fall with the square of the cap: 16 times
+/// 256 leaves each within 0.0002%. Fast marching gains nothing measurable from a higher
+/// cap (0.0003% on the Death Star), and its Death Star took 4% longer at 4096.
+const NAIVE_STEPS: u32 = 16;
 
 /// Rays travel at most this many scene radii ([`PreparedScene::scale`]): the one length that
 /// follows the whole scene, since where a ray gives up looking decides nothing about where
