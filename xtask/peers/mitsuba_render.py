@@ -1,7 +1,8 @@
 """Render a lueur scene file with Mitsuba 3, for `cargo xtask peers`.
 
-Translates what both renderers can express (boxes, spheres, Lambertian and
-mirror materials, sphere and quad lights, a pinhole camera) and refuses the
+Translates what both renderers can express (boxes, spheres and planes with
+lueur's transform keys, Lambertian and mirror materials, sphere, rectangle
+and directional lights, a constant sky, a pinhole camera) and refuses the
 rest, renders with Mitsuba's `path` integrator (BSDF and emitter sampling
 combined by the power heuristic: lueur's `mis`), and prints its timings as
 `key value` lines. Never a build or test dependency of lueur: only the xtask
@@ -41,6 +42,40 @@ import tomllib
 def fail(msg):
     print(f"mitsuba_render.py: {msg}", file=sys.stderr)
     sys.exit(2)
+
+
+def normalized(v):
+    length = sum(c * c for c in v) ** 0.5
+    return [c / length for c in v]
+
+
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def frame_to(T, n, origin, half):
+    """The square `half` wide on each side of `origin`, in the plane of unit normal `n`,
+    as a transform of Mitsuba's rectangle (whose normal is +z)."""
+    a = [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0]
+    s = normalized(cross(a, n))
+    t = cross(n, s)
+    m = [[half * s[r], half * t[r], n[r], origin[r]] for r in range(3)] + [[0, 0, 0, 1]]
+    return T(m)
+
+
+def transformed(T, shape):
+    """lueur's transform keys as one transform: `scale`, then `rotate` (degrees about the
+    fixed x, then y, then z axes), then `translate`, applied after the shape's own
+    centre, as `crates/scene/src/shape.rs` applies them."""
+    tr = T()
+    if "translate" in shape:
+        tr = tr.translate(shape["translate"])
+    if "rotate" in shape:
+        rx, ry, rz = shape["rotate"]
+        tr = tr.rotate([0, 0, 1], rz).rotate([0, 1, 0], ry).rotate([1, 0, 0], rx)
+    if "scale" in shape:
+        tr = tr.scale(shape["scale"])
+    return tr
 
 
 def translate(scene, args, mi):
@@ -89,23 +124,25 @@ def translate(scene, args, mi):
     for i, o in enumerate(scene.get("objects", [])):
         shape = o["shape"]
         bsdf = materials[o["material"]]
-        if shape["type"] == "box":
-            d[f"object{i}"] = {
-                "type": "cube",
-                "to_world": T().translate(shape["center"]).scale(shape["half_extents"]),
-                "bsdf": bsdf,
-            }
-        elif shape["type"] == "sphere":
-            d[f"object{i}"] = {
-                "type": "sphere",
-                "center": shape["center"],
-                "radius": shape["radius"],
-                "bsdf": bsdf,
-            }
+        kind = shape["type"]
+        if kind == "box":
+            unit = {"type": "cube"}
+            local = T().translate(shape.get("center", [0, 0, 0])).scale(shape["half_extents"])
+        elif kind == "sphere":
+            unit = {"type": "sphere"}
+            local = T().translate(shape.get("center", [0, 0, 0])).scale(shape["radius"])
+        elif kind == "plane":
+            # The half-space below `normal . p = height`, as the square 2e4 wide its top
+            # face is: wide enough that no ray the image sees reaches its edge.
+            n = normalized(shape["normal"])
+            unit = {"type": "rectangle"}
+            local = frame_to(T, n, [c * shape.get("height", 0.0) for c in n], 1e4)
         else:
-            fail(f"object {i}: shape {shape['type']} has no Mitsuba twin here")
+            fail(f"object {i}: shape {kind} has no Mitsuba twin here")
+        d[f"object{i}"] = {**unit, "to_world": transformed(T, shape) @ local, "bsdf": bsdf}
     for i, light in enumerate(scene.get("lights", [])):
-        emitter = {"type": "area", "radiance": {"type": "rgb", "value": light["radiance"]}}
+        emitter = {"type": "area", "radiance": {"type": "rgb", "value": light["radiance"]}} \
+            if "radiance" in light else None
         black = {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0, 0, 0]}}
         if light["type"] == "sphere":
             d[f"light{i}"] = {
@@ -115,10 +152,35 @@ def translate(scene, args, mi):
                 "emitter": emitter,
                 "bsdf": black,
             }
+        elif light["type"] == "quad":
+            # Mitsuba's rectangle is [-1, 1]^2 at z = 0, emitting toward +z: its columns
+            # are the half edges, and the normal's column the edges' cross product, which
+            # both renderers emit toward.
+            u, v = light["edge_u"], light["edge_v"]
+            if abs(sum(a * b for a, b in zip(u, v))) > 1e-6 * sum(a * a for a in u + v):
+                fail(f"light {i}: a parallelogram that is no rectangle has no Mitsuba twin here")
+            n = cross(u, v)
+            c = [light["corner"][k] + (u[k] + v[k]) / 2 for k in range(3)]
+            m = [[u[r] / 2, v[r] / 2, n[r], c[r]] for r in range(3)] + [[0, 0, 0, 1]]
+            d[f"light{i}"] = {
+                "type": "rectangle",
+                "to_world": T(m),
+                "emitter": emitter,
+                "bsdf": black,
+            }
+        elif light["type"] == "directional":
+            d[f"light{i}"] = {
+                "type": "directional",
+                "direction": normalized(light["direction"]),
+                "irradiance": {"type": "rgb", "value": light["irradiance"]},
+            }
         else:
             fail(f"light {i}: type {light['type']} has no Mitsuba twin here")
     if "sky" in scene:
-        fail("a sky has no Mitsuba twin here")
+        d["sky"] = {
+            "type": "constant",
+            "radiance": {"type": "rgb", "value": scene["sky"]["radiance"]},
+        }
     return d
 
 

@@ -11,7 +11,11 @@
 //! 1. **Correctness**: lueur's `mis` with independent samples at the
 //!    highest spp against a Mitsuba reference (`llvm_ad_rgb`, independent,
 //!    many passes with other seeds): per-channel image means and a z-map
-//!    over 8x8-pixel regions, each z using both images' standard errors.
+//!    over 8x8-pixel regions, each z using both images' standard errors. The
+//!    same on `xtask/peers/open-air.toml`, a scene made for this report with
+//!    every kind of light and shape both express (a plane, transformed boxes,
+//!    rectangle and directional lights, a sky), at the default camera shell
+//!    and at a thin one.
 //! 2. **Speed and efficiency**: every configuration at 4 to 256 spp, MSE
 //!    against the reference (less the reference's own variance) and the
 //!    render time (lueur: its own measured render; Mitsuba: the warm
@@ -41,6 +45,13 @@ use crate::{load_scene, project_root};
 
 /// The one shipped scene Mitsuba can express as it is.
 pub const SCENE: &str = "cornell-spheres";
+/// A scene made for this report (`xtask/peers/`): a plane, boxes turned and scaled by the
+/// transform keys, a rectangle light, a light at infinity and a sky, which the shipped
+/// scene Mitsuba can express has none of.
+const OPEN_AIR: &str = "open-air";
+/// The camera hit threshold, in pixel footprints, of the second render of [`OPEN_AIR`]:
+/// thin enough that the silhouettes the default threshold grows are no longer seen.
+const THIN_SHELL: f32 = 1.0 / 1024.0;
 const LLVM19: &str = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1";
 
 struct Plan {
@@ -54,6 +65,9 @@ struct Plan {
     reference_pass_spp: u32,
     /// lueur's render for the correctness z-map.
     correctness_spp: u32,
+    /// [`OPEN_AIR`]'s image size, its reference's passes and spp per pass, and lueur's
+    /// spp.
+    open_air: [u32; 4],
 }
 
 const PLANS: Plans<Plan> = Plans {
@@ -64,6 +78,7 @@ const PLANS: Plans<Plan> = Plans {
         reference_passes: 16,
         reference_pass_spp: 256,
         correctness_spp: 1024,
+        open_air: [128, 16, 1024, 4096],
     },
     quick: Plan {
         size: 64,
@@ -72,6 +87,7 @@ const PLANS: Plans<Plan> = Plans {
         reference_passes: 4,
         reference_pass_spp: 64,
         correctness_spp: 64,
+        open_air: [32, 4, 64, 64],
     },
 };
 
@@ -155,24 +171,39 @@ fn scene_path() -> PathBuf {
     project_root().join("scenes").join(format!("{SCENE}.toml"))
 }
 
+/// The scene of every kind of light and shape both renderers express (not shipped: it
+/// exists for this report).
+fn open_air_path() -> PathBuf {
+    project_root()
+        .join("xtask")
+        .join("peers")
+        .join(format!("{OPEN_AIR}.toml"))
+}
+
 /// Runs the Mitsuba script on [`SCENE`]; returns the numbers it prints,
 /// one `key value` line each.
 pub fn mitsuba(args: &[String]) -> Result<HashMap<String, f64>> {
+    mitsuba_on(&scene_path(), &load_scene(SCENE)?, args)
+}
+
+/// Runs the Mitsuba script on the scene file at `path`, parsed as `file`.
+fn mitsuba_on(path: &Path, file: &SceneFile, args: &[String]) -> Result<HashMap<String, f64>> {
     // Mitsuba's `rr_depth` and lueur's `roulette_depth` both count scattering events
     // before roulette may end a path: the same number runs the same estimator. One
     // bounce more of full survival costs Mitsuba 5-7% more time and saves it about a
     // sixth of its MSE (docs/PERFORMANCE.md, "Where the MSE gap is").
-    let roulette_depth = load_scene(SCENE)?.settings.roulette_depth;
+    let roulette_depth = file.settings.roulette_depth;
     let out = python()
         .arg(script())
-        .arg(scene_path())
+        .arg(path)
         .args(args)
         .args(["--rr-depth".to_owned(), roulette_depth.to_string()])
         .output()
         .context("cannot run python3")?;
     if !out.status.success() {
         bail!(
-            "mitsuba_render.py {}: {}",
+            "mitsuba_render.py {} {}: {}",
+            path.display(),
             args.join(" "),
             String::from_utf8_lossy(&out.stderr)
         );
@@ -201,6 +232,7 @@ pub fn run(quick: bool) -> Result<()> {
     let reference_var = read_rgb(&reference_path.with_extension("var.exr"))?;
     let file = load_scene(SCENE)?;
     let correctness = correctness(plan, &file, &reference, &reference_var)?;
+    let open_air = open_air(plan, &work)?;
     let against = Reference {
         mean: reference.pixels,
         var_of_mean: reference_var.pixels,
@@ -269,7 +301,7 @@ pub fn run(quick: bool) -> Result<()> {
             )
         })
         .collect();
-    let md = report(plan, &results, &correctness, reference_time)?;
+    let md = report(plan, &results, &correctness, &open_air, reference_time)?;
     write_report(quick, "PEERS.md", &md)?;
     Ok(())
 }
@@ -279,44 +311,73 @@ pub fn run(quick: bool) -> Result<()> {
 /// of the scene text, the plan and Mitsuba's version only. Returns its path
 /// and how long it took (NaN when cached).
 fn mitsuba_reference(plan: &Plan, work: &Path) -> Result<(PathBuf, f64)> {
-    let reference_path = work.join(format!("reference-{}px.exr", plan.size));
-    eprintln!(
-        "reference: Mitsuba llvm_ad_rgb, {} passes of {} spp",
-        plan.reference_passes, plan.reference_pass_spp
-    );
-    let mut args = vec!["llvm_ad_rgb".to_string()];
-    args.push(plan.reference_pass_spp.to_string());
-    args.push(reference_path.display().to_string());
-    args.extend([
-        "--passes".into(),
-        plan.reference_passes.to_string(),
-        "--seed".into(),
-        "100000".into(),
-        "--width".into(),
-        plan.size.to_string(),
-        "--height".into(),
-        plan.size.to_string(),
-    ]);
-    let key = format!(
-        "{}\n{} {} {}\n{}",
-        std::fs::read_to_string(scene_path())?,
-        plan.size,
-        plan.reference_passes,
-        plan.reference_pass_spp,
-        mitsuba_version()
-    );
-    let key_path = reference_path.with_extension("key");
-    let cached = std::fs::read_to_string(&key_path).is_ok_and(|k| k == key)
-        && reference_path.with_extension("var.exr").exists();
-    let reference_time = if cached {
-        eprintln!("reference: cached in {}", reference_path.display());
-        f64::NAN
-    } else {
-        let t = mitsuba(&args)?.get("total_s").copied().unwrap_or(f64::NAN);
-        std::fs::write(&key_path, &key)?;
-        t
+    let shot = Shot {
+        path: scene_path(),
+        size: plan.size,
+        passes: plan.reference_passes,
+        pass_spp: plan.reference_pass_spp,
     };
-    Ok((reference_path, reference_time))
+    shot.reference(
+        &load_scene(SCENE)?,
+        &work.join(format!("reference-{}px.exr", plan.size)),
+    )
+}
+
+/// A Mitsuba reference of a scene file: `passes` renders of `pass_spp` at `size` squared.
+struct Shot {
+    path: PathBuf,
+    size: u32,
+    passes: u32,
+    pass_spp: u32,
+}
+
+impl Shot {
+    /// Renders the reference into `reference_path` (and its variance beside it) unless a
+    /// render of the same scene text, plan and Mitsuba version is there; returns the path
+    /// and the seconds it took (NaN when cached).
+    fn reference(&self, file: &SceneFile, reference_path: &Path) -> Result<(PathBuf, f64)> {
+        eprintln!(
+            "reference: Mitsuba llvm_ad_rgb, {} passes of {} spp, {}",
+            self.passes,
+            self.pass_spp,
+            self.path.display()
+        );
+        let args: Vec<String> = vec![
+            "llvm_ad_rgb".into(),
+            self.pass_spp.to_string(),
+            reference_path.display().to_string(),
+            "--passes".into(),
+            self.passes.to_string(),
+            "--seed".into(),
+            "100000".into(),
+            "--width".into(),
+            self.size.to_string(),
+            "--height".into(),
+            self.size.to_string(),
+        ];
+        let key = format!(
+            "{}\n{} {} {}\n{}",
+            std::fs::read_to_string(&self.path)?,
+            self.size,
+            self.passes,
+            self.pass_spp,
+            mitsuba_version()
+        );
+        let key_path = reference_path.with_extension("key");
+        let cached = std::fs::read_to_string(&key_path).is_ok_and(|k| k == key)
+            && reference_path.with_extension("var.exr").exists();
+        let reference_time = if cached {
+            eprintln!("reference: cached in {}", reference_path.display());
+            f64::NAN
+        } else {
+            let t = (mitsuba_on(&self.path, file, &args)?.get("total_s"))
+                .copied()
+                .unwrap_or(f64::NAN);
+            std::fs::write(&key_path, &key)?;
+            t
+        };
+        Ok((reference_path.to_path_buf(), reference_time))
+    }
 }
 
 /// Correctness first: independent samples (their standard errors are
@@ -349,6 +410,92 @@ fn correctness(
         reference_var,
         plan.size,
     )
+}
+
+/// Correctness on [`OPEN_AIR`]: lueur at the default camera shell and at [`THIN_SHELL`],
+/// each against a Mitsuba reference, in a section of the report.
+fn open_air(plan: &Plan, work: &Path) -> Result<String> {
+    let [size, passes, pass_spp, spp] = plan.open_air;
+    let path = open_air_path();
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let file = lueur::scene::parse_scene(&text, &format!("xtask/peers/{OPEN_AIR}.toml"))?;
+    let shot = Shot {
+        path,
+        size,
+        passes,
+        pass_spp,
+    };
+    let (reference_path, seconds) =
+        shot.reference(&file, &work.join(format!("{OPEN_AIR}-{size}px.exr")))?;
+    let reference = read_rgb(&reference_path)?;
+    let reference_var = read_rgb(&reference_path.with_extension("var.exr"))?;
+    let mut md = String::new();
+    writeln!(
+        md,
+        "## Correctness on every kind of light\n\n`xtask/peers/{OPEN_AIR}.toml`, made for \
+         this report: a plane (Mitsuba's twin is a square 2e4 wide, whose edge no ray the \
+         image sees reaches), a diffuse and a mirror sphere, boxes turned, scaled and moved by \
+         the transform keys, a rectangle light facing down, a light at infinity and a sky; \
+         {size}x{size}, max_depth {}. lueur (`mis`, independent samples, {spp} spp, seed 7) \
+         against a Mitsuba reference (`llvm_ad_rgb`, {passes} x {pass_spp} spp{}), twice: \
+         with the default camera shell, and with a shell of {} pixel. A camera ray that passes \
+         within the shell of a silhouette is a hit, so silhouettes grow by the shell's width; \
+         Mitsuba's intersections are exact. The thin shell shows what is left once that is \
+         gone.\n",
+        file.settings.max_depth,
+        if seconds.is_finite() {
+            format!("; {seconds:.0} s")
+        } else {
+            String::new()
+        },
+        fraction(THIN_SHELL),
+    )?;
+    for (label, pixel_epsilon) in [
+        (
+            format!(
+                "default shell ({} pixel)",
+                fraction(file.settings.pixel_epsilon)
+            ),
+            file.settings.pixel_epsilon,
+        ),
+        (
+            format!("shell of {} pixel", fraction(THIN_SHELL)),
+            THIN_SHELL,
+        ),
+    ] {
+        eprintln!("open air: lueur mis, independent, {spp} spp, {label}");
+        let settings = RenderSettings {
+            width: size,
+            height: size,
+            spp,
+            strategy: Strategy::Mis,
+            sampler: SamplerKind::Independent,
+            seed: 7,
+            pixel_epsilon,
+            ..file.settings.clone()
+        };
+        let (film, _) = render_film(&file, &settings)?;
+        let table = compare(
+            &flatten(&film.mean_image()),
+            &film.variance_image(),
+            &reference,
+            &reference_var,
+            size,
+        )?;
+        writeln!(md, "**{label}**\n\n{table}")?;
+    }
+    Ok(md)
+}
+
+/// `x` as `1/n` where it is the inverse of a whole number.
+fn fraction(x: f32) -> String {
+    let n = 1.0 / x;
+    if n.fract() == 0.0 {
+        format!("1/{n}")
+    } else {
+        format!("{x}")
+    }
 }
 
 /// One render of a configuration at `spp`: its time and its MSE against the reference
@@ -498,6 +645,7 @@ fn report(
     plan: &Plan,
     results: &[(Config, Vec<Measured>)],
     correctness: &str,
+    open_air: &str,
     reference_time: f64,
 ) -> Result<String> {
     let mut md = String::new();
@@ -537,6 +685,7 @@ fn report(
         }
     )?;
     writeln!(md, "{correctness}")?;
+    writeln!(md, "{open_air}")?;
     writeln!(md, "## Speed and error\n")?;
     writeln!(
         md,
