@@ -443,8 +443,9 @@ fn horizon(out: &mut String, quick: bool) -> Result<()> {
          shells before it crosses. Each cell: the mean over the rows whose footprints lie in the distance \
          band, relative to the closed form integrated over each pixel (16x16 points), and \
          its z-score. Naive marching takes every step the field allows, with no bounds to \
-         clip to: past 40 m its camera rays reach the step cap (`max_steps`) short of the \
-         floor and are shaded where they stopped.\n\n| floor | distance | closed form | fast | naive |\n|---|---|---|---|---|"
+         clip to: its camera rays past 40 m crawl toward the floor, and at a cap of 256 \
+         steps gave up short of it (-95% on the thick floor); it takes 16 times \
+         `max_steps`.\n\n| floor | distance | closed form | fast | naive |\n|---|---|---|---|---|"
     );
     let bands = [
         (3.5, 5.0),
