@@ -588,7 +588,7 @@ fn a_floor_seen_at_grazing_angles_keeps_its_closed_form() {
         sampler: SamplerKind::Stratified,
         max_depth: 1,
         seed: 5,
-        // The shell of the default before a 64th: the wider the shell, the farther a
+        // A wider shell than the default's: the wider the shell, the farther a
         // grazing hit stops from its crossing, so the test has the most power there.
         pixel_epsilon: 1.0 / 16.0,
         ..Default::default()

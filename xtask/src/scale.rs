@@ -439,7 +439,7 @@ fn horizon(out: &mut String, quick: bool) -> Result<()> {
          radiance 100 at height 2; {size}x{size}, {spp} spp, `light`, `stratified`, \
          `max_depth = 1`, seed 0. A camera ray meets the floor at slope `s` (the sine of its \
          angle to it, 0.1 at 5 m, 0.01 at 50 m); the tracer stops where it enters its \
-         shell, `pixel_epsilon` (1/64) of a pixel's footprint above the floor, `1/s` \
+         shell, `pixel_epsilon` (1/256) of a pixel's footprint above the floor, `1/s` \
          shells before it crosses. Each cell: the mean over the rows whose footprints lie in the distance \
          band, relative to the closed form integrated over each pixel (16x16 points), and \
          its z-score. Naive marching takes every step the field allows, with no bounds to \

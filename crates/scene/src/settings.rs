@@ -68,7 +68,7 @@ impl Default for RenderSettings {
             roulette_depth: 3,
             seed: 0,
             max_steps: 256,
-            // A 64th of a pixel: a ray that passes this close to a surface
+            // A 256th of a pixel: a ray that passes this close to a surface
             // is a hit, so silhouettes and convex creases grow by this
             // much. At a quarter pixel they grew visibly against Mitsuba's
             // exact intersections (24 of 3072 8x8-pixel region-channels
@@ -76,10 +76,15 @@ impl Default for RenderSettings {
             // corners; none at a sixteenth: docs/PEERS.md). At a sixteenth
             // the Death Star's rim pixels were still up to 2.6 times too
             // bright against a shell of 1/1000 (333 of 16384 pixels beyond
-            // 2%, the image mean +0.086%); at a 64th, 66 pixels and +0.021%
-            // (the bias is linear in the shell), for no measurable time
-            // (0.98, 0.99, 1.01 of a sixteenth's on the shipped scenes).
-            pixel_epsilon: 0.015625,
+            // 2%, the image mean +0.086%); at a 64th, 66 pixels and +0.021%;
+            // at a 256th, 7 pixels and +0.005% (the bias is linear in the
+            // shell). At a 64th, `xtask/peers/open-air.toml` still showed its
+            // silhouettes against Mitsuba (RMS z 1.13 over 768 region-channels
+            // at 4096 spp, 2 beyond 4 sigma); at a 256th RMS z 1.01, none, as
+            // at a 1024th (docs/PEERS.md). Time against a 64th: Death Star
+            // 1.016 (95% interval 1.002-1.032), Cornell 1.014 and donut 0.978
+            // (intervals holding 1; `cargo xtask ab`, 11 rounds, 2 threads).
+            pixel_epsilon: 0.00390625,
             epsilon_rel: 1e-4,
             marching: Marching::default(),
             quad_sampling: QuadSampling::default(),

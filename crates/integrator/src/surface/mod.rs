@@ -210,7 +210,7 @@ impl<L: Lane> HitPrecision<L> {
 }
 
 /// A hit made usable for shading: the tracer stops anywhere in a shell of
-/// width `epsilon` around the surface (a 64th of a pixel for camera
+/// width `epsilon` around the surface (a 256th of a pixel for camera
 /// rays, by default), so
 /// shading there would measure light from the wrong point. One Newton step
 /// *along the ray* moves the point onto the surface where the ray crosses
