@@ -231,7 +231,13 @@ pub fn run(quick: bool) -> Result<()> {
     let reference = read_rgb(&reference_path)?;
     let reference_var = read_rgb(&reference_path.with_extension("var.exr"))?;
     let file = load_scene(SCENE)?;
-    let correctness = correctness(plan, &file, &reference, &reference_var)?;
+    let correctness = correctness(
+        &file,
+        [plan.size, plan.correctness_spp],
+        file.settings.pixel_epsilon,
+        &reference,
+        &reference_var,
+    )?;
     let open_air = open_air(plan, &work)?;
     let against = Reference {
         mean: reference.pixels,
@@ -382,24 +388,24 @@ impl Shot {
 
 /// Correctness first: independent samples (their standard errors are
 /// honest; a QMC film's overstate the error) at more spp than the speed
-/// series, with another seed.
+/// series, with another seed, at `size` squared and with the camera shell
+/// `pixel_epsilon`: the table [`compare`] makes against the reference.
 fn correctness(
-    plan: &Plan,
     file: &SceneFile,
+    [size, spp]: [u32; 2],
+    pixel_epsilon: f32,
     reference: &Rgb,
     reference_var: &Rgb,
 ) -> Result<String> {
-    eprintln!(
-        "correctness: lueur mis, independent, {} spp",
-        plan.correctness_spp
-    );
+    eprintln!("correctness: lueur mis, independent, {spp} spp, shell {pixel_epsilon}");
     let settings = RenderSettings {
-        width: plan.size,
-        height: plan.size,
-        spp: plan.correctness_spp,
+        width: size,
+        height: size,
+        spp,
         strategy: Strategy::Mis,
         sampler: SamplerKind::Independent,
         seed: 7,
+        pixel_epsilon,
         ..file.settings.clone()
     };
     let (film, _) = render_film(file, &settings)?;
@@ -408,7 +414,7 @@ fn correctness(
         &film.variance_image(),
         reference,
         reference_var,
-        plan.size,
+        size,
     )
 }
 
@@ -464,24 +470,12 @@ fn open_air(plan: &Plan, work: &Path) -> Result<String> {
             THIN_SHELL,
         ),
     ] {
-        eprintln!("open air: lueur mis, independent, {spp} spp, {label}");
-        let settings = RenderSettings {
-            width: size,
-            height: size,
-            spp,
-            strategy: Strategy::Mis,
-            sampler: SamplerKind::Independent,
-            seed: 7,
+        let table = correctness(
+            &file,
+            [size, spp],
             pixel_epsilon,
-            ..file.settings.clone()
-        };
-        let (film, _) = render_film(&file, &settings)?;
-        let table = compare(
-            &flatten(&film.mean_image()),
-            &film.variance_image(),
             &reference,
             &reference_var,
-            size,
         )?;
         writeln!(md, "**{label}**\n\n{table}")?;
     }
