@@ -8,6 +8,7 @@ mod figures;
 mod identical;
 mod instructions;
 mod memory;
+mod mitsuba;
 mod old;
 mod peers;
 mod plot;

@@ -31,14 +31,14 @@
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-use anyhow::{Context, Result, bail, ensure};
+use anyhow::{Context, Result, ensure};
 use lueur::sampling::SamplerKind;
 use lueur::scene::SceneFile;
 use lueur::scene::{RenderSettings, Strategy};
 
 use crate::memory::this_build;
+use crate::mitsuba::{Shot, installed, run_script, version};
 use crate::reference::{Reference, cache_dir, flatten, render_film};
 use crate::report::{Plans, write_report};
 use crate::{load_scene, project_root};
@@ -52,7 +52,6 @@ const OPEN_AIR: &str = "open-air";
 /// The camera hit threshold, in pixel footprints, of the second render of [`OPEN_AIR`]:
 /// thin enough that the silhouettes the default threshold grows are no longer seen.
 const THIN_SHELL: f32 = 1.0 / 1024.0;
-const LLVM19: &str = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1";
 
 struct Plan {
     size: u32,
@@ -150,23 +149,6 @@ fn read_rgb(path: &Path) -> Result<Rgb> {
     Ok(Rgb { width, pixels })
 }
 
-/// `python3` (or `$LUEUR_PYTHON`), with `DRJIT_LIBLLVM_PATH` pointing at
-/// Debian's libLLVM 19 when it is there and the variable is unset.
-pub fn python() -> Command {
-    let mut c = Command::new(std::env::var("LUEUR_PYTHON").unwrap_or_else(|_| "python3".into()));
-    if std::env::var_os("DRJIT_LIBLLVM_PATH").is_none() && Path::new(LLVM19).exists() {
-        c.env("DRJIT_LIBLLVM_PATH", LLVM19);
-    }
-    c
-}
-
-fn script() -> PathBuf {
-    project_root()
-        .join("xtask")
-        .join("peers")
-        .join("mitsuba_render.py")
-}
-
 fn scene_path() -> PathBuf {
     project_root().join("scenes").join(format!("{SCENE}.toml"))
 }
@@ -183,44 +165,13 @@ fn open_air_path() -> PathBuf {
 /// Runs the Mitsuba script on [`SCENE`]; returns the numbers it prints,
 /// one `key value` line each.
 pub fn mitsuba(args: &[String]) -> Result<HashMap<String, f64>> {
-    mitsuba_on(&scene_path(), &load_scene(SCENE)?, args)
-}
-
-/// Runs the Mitsuba script on the scene file at `path`, parsed as `file`.
-fn mitsuba_on(path: &Path, file: &SceneFile, args: &[String]) -> Result<HashMap<String, f64>> {
-    // Mitsuba's `rr_depth` and lueur's `roulette_depth` both count scattering events
-    // before roulette may end a path: the same number runs the same estimator. One
-    // bounce more of full survival costs Mitsuba 5-7% more time and saves it about a
-    // sixth of its MSE (docs/PERFORMANCE.md, "Where the MSE gap is").
-    let roulette_depth = file.settings.roulette_depth;
-    let out = python()
-        .arg(script())
-        .arg(path)
-        .args(args)
-        .args(["--rr-depth".to_owned(), roulette_depth.to_string()])
-        .output()
-        .context("cannot run python3")?;
-    if !out.status.success() {
-        bail!(
-            "mitsuba_render.py {} {}: {}",
-            path.display(),
-            args.join(" "),
-            String::from_utf8_lossy(&out.stderr)
-        );
-    }
-    Ok(String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .filter_map(|line| {
-            let (key, value) = line.split_once(' ')?;
-            Some((key.to_owned(), value.trim().parse().ok()?))
-        })
-        .collect())
+    run_script(&scene_path(), &load_scene(SCENE)?, args)
 }
 
 pub fn run(quick: bool) -> Result<()> {
     let plan = PLANS.pick(quick);
     ensure!(
-        mitsuba_installed()?,
+        installed()?,
         "Mitsuba 3 (with numpy, which its multi-pass renders use) is not installed for \
          python3: `pip install mitsuba numpy` (and, for llvm_ad_rgb, Debian's libllvm19). It is \
          a peer for this report only, never a dependency of lueur."
@@ -327,63 +278,6 @@ fn mitsuba_reference(plan: &Plan, work: &Path) -> Result<(PathBuf, f64)> {
         &load_scene(SCENE)?,
         &work.join(format!("reference-{}px.exr", plan.size)),
     )
-}
-
-/// A Mitsuba reference of a scene file: `passes` renders of `pass_spp` at `size` squared.
-struct Shot {
-    path: PathBuf,
-    size: u32,
-    passes: u32,
-    pass_spp: u32,
-}
-
-impl Shot {
-    /// Renders the reference into `reference_path` (and its variance beside it) unless a
-    /// render of the same scene text, plan and Mitsuba version is there; returns the path
-    /// and the seconds it took (NaN when cached).
-    fn reference(&self, file: &SceneFile, reference_path: &Path) -> Result<(PathBuf, f64)> {
-        eprintln!(
-            "reference: Mitsuba llvm_ad_rgb, {} passes of {} spp, {}",
-            self.passes,
-            self.pass_spp,
-            self.path.display()
-        );
-        let args: Vec<String> = vec![
-            "llvm_ad_rgb".into(),
-            self.pass_spp.to_string(),
-            reference_path.display().to_string(),
-            "--passes".into(),
-            self.passes.to_string(),
-            "--seed".into(),
-            "100000".into(),
-            "--width".into(),
-            self.size.to_string(),
-            "--height".into(),
-            self.size.to_string(),
-        ];
-        let key = format!(
-            "{}\n{} {} {}\n{}",
-            std::fs::read_to_string(&self.path)?,
-            self.size,
-            self.passes,
-            self.pass_spp,
-            mitsuba_version()
-        );
-        let key_path = reference_path.with_extension("key");
-        let cached = std::fs::read_to_string(&key_path).is_ok_and(|k| k == key)
-            && reference_path.with_extension("var.exr").exists();
-        let reference_time = if cached {
-            eprintln!("reference: cached in {}", reference_path.display());
-            f64::NAN
-        } else {
-            let t = (mitsuba_on(&self.path, file, &args)?.get("total_s"))
-                .copied()
-                .unwrap_or(f64::NAN);
-            std::fs::write(&key_path, &key)?;
-            t
-        };
-        Ok((reference_path.to_path_buf(), reference_time))
-    }
 }
 
 /// Correctness first: independent samples (their standard errors are
@@ -656,7 +550,7 @@ fn report(
          `roulette_depth` = {}, scattering events). Both on this machine's 2 cores, in one \
          run. Mitsuba is a peer for this report, never a dependency: the report refuses to \
          run without it.\n",
-        mitsuba_version(),
+        version(),
         load_scene(SCENE)?.settings.roulette_depth,
     )?;
     writeln!(md, "## Correctness\n")?;
@@ -782,24 +676,4 @@ fn summary(md: &mut String, plan: &Plan, results: &[(Config, Vec<Measured>)]) ->
 /// A configuration's figures at `spp`.
 fn at(rows: &[Measured], spp: u32) -> Option<&Measured> {
     rows.iter().find(|m| m.spp == spp)
-}
-
-/// Whether `python()` can import Mitsuba 3, and numpy, which `mitsuba_render.py`'s
-/// multi-pass renders need.
-pub fn mitsuba_installed() -> Result<bool> {
-    let check = python()
-        .args(["-c", "import mitsuba, numpy"])
-        .output()
-        .context("cannot run python3")?;
-    Ok(check.status.success())
-}
-
-/// Mitsuba's version as Python reports it ("3" when it cannot say).
-pub fn mitsuba_version() -> String {
-    python()
-        .args(["-c", "import mitsuba; print(mitsuba.__version__)"])
-        .output()
-        .ok()
-        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned())
-        .unwrap_or_else(|| "3".into())
 }

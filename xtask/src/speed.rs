@@ -24,8 +24,9 @@ use lueur::integrator::Execution;
 use lueur::sdf_math::SimdLevel;
 
 use crate::memory::{Build, build_lueur_as};
+use crate::mitsuba::{installed as mitsuba_installed, version as mitsuba_version};
 use crate::old::{self, Old};
-use crate::peers::{SCENE as MITSUBA_SCENE, mitsuba, mitsuba_installed, mitsuba_version};
+use crate::peers::{SCENE as MITSUBA_SCENE, mitsuba};
 use crate::reference::cache_dir;
 use crate::report::{Plans, quick_flag, write_report};
 use crate::{project_root, run_lueur, shipped_scenes};
