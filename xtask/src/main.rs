@@ -362,10 +362,15 @@ pub fn run_lueur(binary: &Path, args: &[String]) -> Result<()> {
 
 /// Loads `scenes/NAME.toml`.
 pub fn load_scene(name: &str) -> Result<SceneFile> {
-    let path = project_root().join("scenes").join(format!("{name}.toml"));
+    load_scene_at(&format!("scenes/{name}.toml"))
+}
+
+/// Loads the scene file at `relative`, a path from the project root (which its errors name).
+pub fn load_scene_at(relative: &str) -> Result<SceneFile> {
+    let path = project_root().join(relative);
     let text =
         std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    Ok(parse_scene(&text, &format!("scenes/{name}.toml"))?)
+    Ok(parse_scene(&text, relative)?)
 }
 
 /// Renders with a progress bar labelled `label`.

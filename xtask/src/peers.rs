@@ -41,14 +41,14 @@ use crate::memory::this_build;
 use crate::mitsuba::{Shot, installed, run_script, version};
 use crate::reference::{Reference, cache_dir, flatten, render_film};
 use crate::report::{Plans, write_report};
-use crate::{load_scene, project_root};
+use crate::{load_scene, load_scene_at, project_root};
 
 /// The one shipped scene Mitsuba can express as it is.
 pub const SCENE: &str = "cornell-spheres";
-/// A scene made for this report (`xtask/peers/`): a plane, boxes turned and scaled by the
+/// A scene file made for this report, from the project root: a plane, boxes turned and scaled by the
 /// transform keys, a rectangle light, a light at infinity and a sky, which the shipped
 /// scene Mitsuba can express has none of.
-const OPEN_AIR: &str = "open-air";
+const OPEN_AIR: &str = "xtask/peers/open-air.toml";
 /// The camera hit threshold, in pixel footprints, of the second render of [`OPEN_AIR`]:
 /// thin enough that the silhouettes the default threshold grows are no longer seen.
 const THIN_SHELL: f32 = 1.0 / 1024.0;
@@ -151,15 +151,6 @@ fn read_rgb(path: &Path) -> Result<Rgb> {
 
 fn scene_path() -> PathBuf {
     project_root().join("scenes").join(format!("{SCENE}.toml"))
-}
-
-/// The scene of every kind of light and shape both renderers express (not shipped: it
-/// exists for this report).
-fn open_air_path() -> PathBuf {
-    project_root()
-        .join("xtask")
-        .join("peers")
-        .join(format!("{OPEN_AIR}.toml"))
 }
 
 /// Runs the Mitsuba script on [`SCENE`]; returns the numbers it prints,
@@ -316,24 +307,21 @@ fn correctness(
 /// each against a Mitsuba reference, in a section of the report.
 fn open_air(plan: &Plan, work: &Path) -> Result<String> {
     let [size, passes, pass_spp, spp] = plan.open_air;
-    let path = open_air_path();
-    let text =
-        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    let file = lueur::scene::parse_scene(&text, &format!("xtask/peers/{OPEN_AIR}.toml"))?;
+    let file = load_scene_at(OPEN_AIR)?;
     let shot = Shot {
-        path,
+        path: project_root().join(OPEN_AIR),
         size,
         passes,
         pass_spp,
     };
     let (reference_path, seconds) =
-        shot.reference(&file, &work.join(format!("{OPEN_AIR}-{size}px.exr")))?;
+        shot.reference(&file, &work.join(format!("open-air-{size}px.exr")))?;
     let reference = read_rgb(&reference_path)?;
     let reference_var = read_rgb(&reference_path.with_extension("var.exr"))?;
     let mut md = String::new();
     writeln!(
         md,
-        "## Correctness on every kind of light\n\n`xtask/peers/{OPEN_AIR}.toml`, made for \
+        "## Correctness on every kind of light\n\n`{OPEN_AIR}`, made for \
          this report: a plane (Mitsuba's twin is a square 2e4 wide, whose edge no ray the \
          image sees reaches), a diffuse and a mirror sphere, boxes turned, scaled and moved by \
          the transform keys, a rectangle light facing down, a light at infinity and a sky; \

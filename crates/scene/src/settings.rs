@@ -41,7 +41,8 @@ pub struct RenderSettings {
     pub roulette_depth: u32,
     /// Seed of every random number of the render.
     pub seed: u64,
-    /// Step cap of the sphere tracer.
+    /// Step cap of the sphere tracer; naive marching takes 16 times it (rays crawling
+    /// away from a large plane need many steps without bounds to clip them).
     pub max_steps: u32,
     /// Camera rays hit when closer than this many pixel footprints.
     pub pixel_epsilon: f32,
