@@ -40,6 +40,7 @@ impl Fingerprint {
             ("height", s.height.to_string()),
             ("strategy", s.strategy.to_string()),
             ("sampler", s.sampler.to_string()),
+            ("sampler_revision", s.sampler.revision().to_string()),
             ("seed", s.seed.to_string()),
             ("max_depth", s.max_depth.to_string()),
             ("roulette_depth", s.roulette_depth.to_string()),
@@ -136,6 +137,7 @@ impl Fingerprint {
                 let old = match n {
                     "crop" | "shard" => Some("none"),
                     "set" => Some("[]"),
+                    "sampler_revision" => Some("1"),
                     _ => None,
                 };
                 let (a, b) = (self.get(n).or(old), other.get(n).or(old));
@@ -220,6 +222,31 @@ mod tests {
         assert_eq!(
             old.differences(&cropped, false),
             vec!["crop: none, 1,2,1,2"]
+        );
+    }
+
+    /// A checkpoint made before a fix raised its sampler's revision is not resumed
+    /// with the new values; one of a sampler the fix left alone still is.
+    #[test]
+    fn a_sampler_s_fixed_values_are_not_mixed_with_its_old_ones() {
+        use lueur_sampling::SamplerKind;
+        let now = |sampler: SamplerKind| {
+            let settings = RenderSettings {
+                sampler,
+                ..Default::default()
+            };
+            Fingerprint::of(&settings, None, None, &[])
+        };
+        let before = |fp: &Fingerprint| {
+            Fingerprint::parse(&fp.to_string().replace(" sampler_revision=1", ""))
+        };
+        let sobol = now(SamplerKind::SobolXor);
+        assert!(before(&sobol).differences(&sobol, false).is_empty());
+        let pmj02 = now(SamplerKind::Pmj02);
+        let old = Fingerprint::parse(&pmj02.to_string().replace("sampler_revision=2", ""));
+        assert_eq!(
+            old.differences(&pmj02, false),
+            vec!["sampler_revision: 1, 2"]
         );
     }
 }

@@ -479,7 +479,8 @@ impl Sampler {
             SamplerKind::ZSobol => fraction_to_f32(self.zsobol()[0]),
             SamplerKind::R2 => {
                 let shift = self.sequence_hash(self.dimension);
-                fraction64_to_f32(shift.wrapping_add(u64::from(self.index).wrapping_mul(GOLDEN_1D)))
+                let i = self.kronecker_index(shift);
+                fraction64_to_f32(shift.wrapping_add(i.wrapping_mul(GOLDEN_1D)))
             }
             SamplerKind::Pmj02 => fraction_to_f32(self.pmj02()[0]),
         }
@@ -525,7 +526,7 @@ impl Sampler {
             }
             SamplerKind::R2 => {
                 let shift = self.sequence_hash(self.dimension);
-                let i = u64::from(self.index);
+                let i = self.kronecker_index(shift);
                 let [ax, ay] = R2_INCREMENTS;
                 Vec2::new(
                     fraction64_to_f32(shift.wrapping_add(i.wrapping_mul(ax))),
@@ -539,17 +540,47 @@ impl Sampler {
         }
     }
 
+    /// The index R2 reads for the request whose rotation is `shift`: the sample index
+    /// Owen-scrambled per request, so that each request's points are paired with the
+    /// others' at random. Read at the index itself, every request's `i`-th point is its
+    /// rotation plus the same `i a`, and a pixel's dimension pairs would move together
+    /// (1.7x the MSE of `cmj` at 256 spp on cornell-spheres). A Kronecker sequence's points at
+    /// any run of consecutive indices are its first ones rotated, and the scramble maps
+    /// each aligned block of `2^m` indices to another, so every power-of-two prefix keeps
+    /// R2's spacing, whatever the total spp.
+    #[inline]
+    fn kronecker_index(&self, shift: u64) -> u64 {
+        u64::from(nested_uniform_scramble(self.index, hash2(shift, 2) as u32))
+    }
+
     /// The current sample of a pmj02 table: the index within the pixel's
-    /// pattern of `spp` selects the point, and the pattern block (and, past
-    /// the table's length, the table block) joins the hash that picks the
-    /// table and its XOR shift, so every block is an independent
-    /// randomization.
+    /// pattern of `spp`, permuted per request within its level, selects the
+    /// point, and the pattern block (and, past the table's length, the table
+    /// block) joins the hash that picks the table, the permutation and the
+    /// XOR shift, so every block is an independent randomization.
+    ///
+    /// The permutation pairs each request's points with the others' at
+    /// random, as pbrt-v4's `PMJ02BNSampler` permutes its index past its
+    /// tables. Read at the index itself, every request's `j`-th point sits in
+    /// the same place of the progressive construction (point 1 in the quadrant
+    /// opposite point 0, and so on), up to the shift, and two requests that
+    /// pick the same table differ by a shift alone, so a pixel's dimension
+    /// pairs would move together (1.9x the MSE of `cmj` at 256 spp on
+    /// cornell-spheres). Only the table's power-of-two prefixes are nets (not
+    /// every aligned block), so the index is permuted within its level
+    /// `[2^k, 2^(k+1))`: each prefix `[0, 2^m)` is the table's own, whatever
+    /// the total spp.
     #[inline]
     fn pmj02(&self) -> [u32; 2] {
+        const { assert!(PMJ02_TABLE_LEN.is_power_of_two()) };
         let j = self.index_in_pattern() as usize;
         let h = hash2(self.request_hash(), (j / PMJ02_TABLE_LEN) as u64);
         let table = (h % PMJ02_TABLES as u64) as usize;
-        let [x, y] = pmj02_table_point(table, j % PMJ02_TABLE_LEN);
+        let j = (j % PMJ02_TABLE_LEN) as u32;
+        // The level of `j`: `[2^k, 2^(k+1))`, or `{0}`.
+        let level = if j == 0 { 0 } else { 1 << j.ilog2() };
+        let index = level + permute(j - level, level.max(1), (h >> 32) as u32);
+        let [x, y] = pmj02_table_point(table, index as usize);
         let shift = hash2(h, 0x0078_6f72);
         [x ^ shift as u32, y ^ (shift >> 32) as u32]
     }

@@ -95,14 +95,16 @@ pub enum SamplerKind {
     ZSobol,
     /// Roberts's R2 Kronecker sequence for 2D requests and the golden-ratio
     /// sequence for 1D requests, with a Cranley–Patterson rotation per
-    /// (pixel, dimension).
+    /// (pixel, dimension), read at the sample index Owen-scrambled per
+    /// (pixel, dimension) so that requests pair their points at random.
     R2,
     /// Progressive multi-jittered (0, 2) sequences (Christensen, Kensler and
     /// Kilpatrick 2018): each request reads one of a few shared pmj02 tables
-    /// at the pixel's sample index, chosen and randomized by a digital (XOR)
-    /// shift per (pixel, dimension), which keeps every power-of-two prefix
-    /// a (0, m, 2)-net, like pbrt-v4's `PMJ02BNSampler` (without its blue-
-    /// noise pixel ordering). 1D requests take the x coordinate, a
+    /// at the pixel's sample index permuted within its power-of-two level,
+    /// chosen and randomized by a digital (XOR) shift per (pixel,
+    /// dimension), which keeps every power-of-two prefix a (0, m, 2)-net,
+    /// like pbrt-v4's `PMJ02BNSampler` (without its blue-noise pixel
+    /// ordering). 1D requests take the x coordinate, a
     /// stratified (0, 1)-sequence. Tables hold 4096 samples; past them (or
     /// past `spp`), a new independent block starts.
     Pmj02,
@@ -162,6 +164,18 @@ impl SamplerKind {
             self,
             SamplerKind::Stratified | SamplerKind::Lhs | SamplerKind::Cmj | SamplerKind::ZSobol
         )
+    }
+
+    /// The revision of the kind's construction, raised when a fix changes the
+    /// values it gives (its golden digest), so that a checkpoint or shard
+    /// made of the old values is never resumed or merged with new ones.
+    /// pmj02 and r2 are at 2: their requests read their points in the same
+    /// order, which moved a pixel's dimension pairs together.
+    pub fn revision(&self) -> u32 {
+        match self {
+            SamplerKind::R2 | SamplerKind::Pmj02 => 2,
+            _ => 1,
+        }
     }
 
     /// Whether the kind is randomized (every kind but the plain Halton and

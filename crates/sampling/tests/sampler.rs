@@ -214,7 +214,9 @@ fn golden_digests_of_every_kind() {
     assert_eq!(got, expected, "{got:#x?}");
 }
 
-/// Every kind's digests, which must never change (see [`golden_values`]).
+/// Every kind's digests, which must never change (see [`golden_values`]) unless a fix
+/// raises the kind's [`SamplerKind::revision`], which keeps checkpoints of the old values
+/// from being resumed or merged with the new.
 const GOLDEN_DIGESTS: [(&str, u64, u64); 12] = [
     ("independent", 0xc2c8c1318fa10877, 0xc2c8c1318fa10877),
     ("stratified", 0x2228afd41c734394, 0xaec88ad0db0eb7f6),
@@ -226,6 +228,6 @@ const GOLDEN_DIGESTS: [(&str, u64, u64); 12] = [
     ("sobol-xor", 0xc5fa021503b440b2, 0x08e124f07e0ee129),
     ("sobol-owen", 0x309ff53b71c59f8e, 0xa6a771adf68d4ef2),
     ("zsobol", 0xec1bd70437ca6c1e, 0x118eddba9e24fee2),
-    ("r2", 0x6d6909cd47f47b40, 0x0a193238c7511832),
-    ("pmj02", 0x755d00e4b799bb63, 0xa045630f0a223d60),
+    ("r2", 0x27cbe64668771354, 0x09bdde19fbd872ca),
+    ("pmj02", 0x74cb40001373f545, 0xf431af034939d2f9),
 ];
