@@ -276,8 +276,8 @@ fn randomized_kinds_are_uniform_across_pixels_and_decorrelated_across_dimensions
 /// read that way had 1.9x and 1.7x the MSE of `cmj` at 256 spp on
 /// cornell-spheres.
 ///
-/// Per pixel, `rho` is the Spearman correlation between the x coordinates
-/// of two requests over the pixel's `n` samples. For a uniformly random
+/// Per pixel, `rho` is the Spearman correlation between the values of two
+/// requests (1D, or a 2D request's x) over the pixel's `n` samples. For a uniformly random
 /// pairing `(n - 1) rho^2` has mean 1 (about chi-square with one degree of
 /// freedom). The kinds that keep every power-of-two prefix a net cannot
 /// pair that freely: their index permutations are nested (or, for pmj02,
@@ -307,9 +307,14 @@ fn a_pixel_s_requests_are_paired_at_random() {
             SamplerKind::Halton | SamplerKind::HaltonOwen | SamplerKind::Sobol
         )
     };
-    // Requests of the path's layout (camera 2D at 0, a vertex's 2D at 3) and
-    // two 2D requests further on.
-    let pairs = [(0, 3), (3, 11)];
+    // Requests of the path's layout (`path_values`): the camera's 2D at 0, a
+    // vertex's 1D at 2, its 2D at 3 and its next 1D at 5, the next vertex's
+    // 2D at 11. A 2D request gives its x.
+    let pairs = [(0, 3), (3, 11), (2, 3), (2, 5)];
+    let value = |sampler: &mut Sampler, dimension: u32| match dimension {
+        2 | 5 => sampler.next_1d(),
+        _ => sampler.next_2d().x,
+    };
     for &kind in SamplerKind::ALL.iter().filter(padded) {
         let mut sampler = Sampler::for_image(kind, 5, [256, 256], n);
         for (a, b) in pairs {
@@ -319,9 +324,9 @@ fn a_pixel_s_requests_are_paired_at_random() {
                 let (mut xa, mut xb) = (Vec::new(), Vec::new());
                 for index in 0..n {
                     sampler.start_pixel_sample(pixel, index, a);
-                    xa.push(sampler.next_2d().x);
+                    xa.push(value(&mut sampler, a));
                     sampler.start_pixel_sample(pixel, index, b);
-                    xb.push(sampler.next_2d().x);
+                    xb.push(value(&mut sampler, b));
                 }
                 let (ra, rb) = (ranks(&xa), ranks(&xb));
                 let d2: f64 = ra.iter().zip(&rb).map(|(x, y)| (x - y).powi(2)).sum();
