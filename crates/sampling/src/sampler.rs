@@ -540,13 +540,14 @@ impl Sampler {
         }
     }
 
-    /// The index R2 reads for the request whose rotation is `shift`: the sample index
-    /// Owen-scrambled per request, so that each request's points are paired with the
-    /// others' at random. Read at the index itself, every request's `i`-th point is its
-    /// rotation plus the same `i a`, and a pixel's dimension pairs would move together
-    /// (1.7x the MSE of `cmj` at 256 spp on cornell-spheres). A Kronecker sequence's points at
-    /// any run of consecutive indices are its first ones rotated, and the scramble maps
-    /// each aligned block of `2^m` indices to another, so every power-of-two prefix keeps
+    /// The index R2 reads for the request whose rotation is `shift`: the sample
+    /// index Owen-scrambled per request, so that each request's points are
+    /// paired with the others' at random. Read at the index itself, every
+    /// request's `i`-th point is its rotation plus the same `i a`, and a pixel's
+    /// dimension pairs would move together (1.7x the MSE of `cmj` at 256 spp on
+    /// cornell-spheres). A Kronecker sequence's points at any run of consecutive
+    /// indices are its first ones rotated, and the scramble maps each aligned
+    /// block of `2^m` indices to another, so every power-of-two prefix keeps
     /// R2's spacing, whatever the total spp.
     #[inline]
     fn kronecker_index(&self, shift: u64) -> u64 {
