@@ -277,9 +277,9 @@ fn randomized_kinds_are_uniform_across_pixels_and_decorrelated_across_dimensions
 /// cornell-spheres.
 ///
 /// Per pixel, `rho` is the Spearman correlation between the values of two
-/// requests (1D, or a 2D request's x) over the pixel's `n` samples. For a uniformly random
-/// pairing `(n - 1) rho^2` has mean 1 (about chi-square with one degree of
-/// freedom). The kinds that keep every power-of-two prefix a net cannot
+/// requests (1D, or a 2D request's x) over the pixel's `n` samples. For a
+/// uniformly random pairing `(n - 1) rho^2` has mean 1 (about chi-square
+/// with one degree of freedom). The kinds that keep every power-of-two prefix a net cannot
 /// pair that freely: their index permutations are nested (or, for pmj02,
 /// kept within each power-of-two level), coarser than a uniform
 /// permutation, and give means of 1.1 to 1.6 here (a uniform
@@ -301,12 +301,7 @@ fn a_pixel_s_requests_are_paired_at_random() {
         }
         rank
     };
-    let padded = |k: &&SamplerKind| {
-        !matches!(
-            k,
-            SamplerKind::Halton | SamplerKind::HaltonOwen | SamplerKind::Sobol
-        )
-    };
+    let padded = |k: &&SamplerKind| randomized(**k) && **k != SamplerKind::HaltonOwen;
     // Requests of the path's layout (`path_values`): the camera's 2D at 0, a
     // vertex's 1D at 2, its 2D at 3 and its next 1D at 5, the next vertex's
     // 2D at 11. A 2D request gives its x.
