@@ -3,6 +3,7 @@
 
 mod aarch64;
 mod ab;
+mod codegen;
 mod compose;
 mod figures;
 mod identical;
@@ -202,6 +203,19 @@ enum Command {
         #[arg(long, value_name = "REV", conflicts_with = "old")]
         old_rev: Option<String>,
     },
+    /// Check that the compiler made lueur's lane kernels of full-width vector
+    /// instructions (zmm for AVX-512, ymm for AVX2), counted in the disassembly;
+    /// writes docs/CODEGEN.md and fails below the floor. x86-64 only; needs objdump.
+    Codegen {
+        /// Another lueur binary to check, instead of building this tree's (no
+        /// report is written then).
+        #[arg(long, value_name = "PATH")]
+        binary: Option<PathBuf>,
+        /// The smallest share of each level's packed arithmetic at its full
+        /// width that passes.
+        #[arg(long, default_value_t = 0.5)]
+        floor: f64,
+    },
     /// Run the workspace's property tests under other seeds than their own
     /// (`PROPTEST_RNG_SEED` = FIRST, FIRST + 1, ...), to find claims that fail on cases
     /// their fixed seeds never draw; prints each failure with its seed and minimal input,
@@ -276,6 +290,7 @@ fn main() -> Result<()> {
             old,
             old_rev,
         } => instructions::run(quick, old.as_deref(), old_rev.as_deref()),
+        Command::Codegen { binary, floor } => codegen::run(binary.as_deref(), floor),
         Command::Properties { first, count } => properties::run(first, count),
         Command::MemoryProbe { command } => memory::probe(&command),
     }
