@@ -42,9 +42,10 @@ const LEVELS: [(&str, &str, &str); 2] = [
 /// The registers, widest first.
 const WIDTHS: [&str; 3] = ["zmm", "ymm", "xmm"];
 
-/// The packed single-precision arithmetic counted, by mnemonic stem (SSE's and VEX's).
-const ARITHMETIC: [&str; 10] = [
-    "add", "sub", "mul", "div", "sqrt", "min", "max", "cmp", "blendv", "blendm",
+/// The packed single-precision arithmetic counted, by mnemonic stem (SSE's and VEX's);
+/// compares too, whatever their predicate (`cmpltps`, `cmpnleps`...).
+const ARITHMETIC: [&str; 9] = [
+    "add", "sub", "mul", "div", "sqrt", "min", "max", "blendv", "blendm",
 ];
 
 /// One kernel function: its address, the address of its first counted instruction, and
@@ -59,6 +60,12 @@ impl Kernel {
     fn total(&self) -> u64 {
         self.counts.values().sum()
     }
+}
+
+/// The share of `counts` in register `width`.
+fn share(counts: &BTreeMap<&'static str, u64>, width: &str) -> f64 {
+    let total: u64 = counts.values().sum();
+    counts.get(width).copied().unwrap_or(0) as f64 / total.max(1) as f64
 }
 
 pub fn run(binary: Option<&Path>, floor: f64) -> Result<()> {
@@ -126,22 +133,21 @@ pub fn run(binary: Option<&Path>, floor: f64) -> Result<()> {
                 binary.display()
             );
         }
-        let mut counts: BTreeMap<&str, u64> = BTreeMap::new();
+        let mut counts: BTreeMap<&'static str, u64> = BTreeMap::new();
         for k in &kernels {
             for (w, n) in &k.counts {
                 *counts.entry(w).or_default() += n;
             }
         }
         let total: u64 = counts.values().sum();
-        let share = |w: &str| counts.get(w).copied().unwrap_or(0) as f64 / total.max(1) as f64;
-        let at_full = share(full);
+        let at_full = share(&counts, full);
         writeln!(
             md,
             "| {level} | {} | {total} | **{at_full:.3}** | {:.3} | {:.3} | {:.3} |",
             kernels.len(),
-            share("zmm"),
-            share("ymm"),
-            share("xmm"),
+            share(&counts, "zmm"),
+            share(&counts, "ymm"),
+            share(&counts, "xmm"),
         )?;
         println!("{level}: {total} packed instructions, {at_full:.3} at full width ({full})");
         if at_full < floor {
@@ -160,8 +166,7 @@ pub fn run(binary: Option<&Path>, floor: f64) -> Result<()> {
         )?;
         writeln!(largest, "|---|---|---|---|")?;
         for (k, name) in kernels.iter().zip(names) {
-            let n = k.total();
-            let at = k.counts.get(full).copied().unwrap_or(0) as f64 / n.max(1) as f64;
+            let (n, at) = (k.total(), share(&k.counts, full));
             writeln!(largest, "| `{name}` | {} | {n} | {at:.3} |", k.address)?;
         }
     }
@@ -309,12 +314,10 @@ fn packed_arithmetic_width(instruction: &str) -> Option<&'static str> {
     let mnemonic = instruction.split_whitespace().next()?;
     let stem = mnemonic.strip_prefix('v').unwrap_or(mnemonic);
     let op = stem.strip_suffix("ps")?;
-    let counted = ARITHMETIC.iter().any(|a| {
-        op == *a
-            || (*a == "cmp"
-                && op.starts_with("cmp")
-                && op[3..].bytes().all(|b| b.is_ascii_lowercase()))
-    });
+    let compare = op
+        .strip_prefix("cmp")
+        .is_some_and(|predicate| predicate.bytes().all(|b| b.is_ascii_lowercase()));
+    let counted = compare || ARITHMETIC.contains(&op);
     if !counted {
         return None;
     }
