@@ -2,12 +2,15 @@
 //! instructions of their level's full width. Writes `docs/CODEGEN.md`; fails where a
 //! level's share falls below the floor.
 //!
-//! A [`Wide`](lueur::sdf_math::Wide) operation is a loop over its lanes, and LLVM is
-//! trusted to make each one instruction of the level's width. It does not always: one
-//! build of the lane-resident prototype ran 2.2x slower than another of the same source,
-//! with 26% of its time in 512-bit instructions against 73% (docs/PERFORMANCE.md, "Paths
-//! resident in lanes: a prototype"). A timing sees that only as "slower", and a compiler
-//! update or a kernel edit could do it to the renderer. This check reads the binary.
+//! AVX2's and AVX-512's lane types are vector instructions themselves
+//! (`crates/sdf-math/src/lanes/x86.rs`), so a kernel's arithmetic is at full width unless
+//! something in it works lane by lane outside `Lane` and LLVM's vectorizer has to put it
+//! back together. That is what went wrong before them: `Wide`'s operations were loops over
+//! lanes, and LLVM made lueur's kernels 0.65 full width under AVX-512 and 0.77 under
+//! AVX2, while one build of the lane-resident prototype ran 2.2x slower than another of
+//! the same source (docs/PERFORMANCE.md, "Paths resident in lanes: a prototype" and
+//! "Explicit vector operations"). A timing sees that only as "slower", and a compiler
+//! update or a kernel edit could do it again. This check reads the binary.
 //!
 //! Each level's kernels are the functions pulp compiles with its target features
 //! (`pulp::x86::v4::V4::vectorize...` for AVX-512): every kernel is inlined whole into

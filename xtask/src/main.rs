@@ -213,7 +213,7 @@ enum Command {
         binary: Option<PathBuf>,
         /// The smallest share of each level's packed arithmetic at its full
         /// width that passes.
-        #[arg(long, default_value_t = 0.5)]
+        #[arg(long, default_value_t = 0.9)]
         floor: f64,
     },
     /// Run the workspace's property tests under other seeds than their own

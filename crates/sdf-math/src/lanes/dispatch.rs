@@ -147,7 +147,13 @@ impl SimdLevel {
                 Portable::within(Run::<K, Wide<8, Portable>>(kernel, PhantomData))
             }
             SimdLevel::Sse => Sse::within(Run::<K, Wide<4, Sse>>(kernel, PhantomData)),
+            #[cfg(target_arch = "x86_64")]
+            SimdLevel::Avx2 => Avx2::within(Run::<K, super::x86::Ymm>(kernel, PhantomData)),
+            #[cfg(not(target_arch = "x86_64"))]
             SimdLevel::Avx2 => Avx2::within(Run::<K, Wide<8, Avx2>>(kernel, PhantomData)),
+            #[cfg(target_arch = "x86_64")]
+            SimdLevel::Avx512 => Avx512::within(Run::<K, super::x86::Zmm>(kernel, PhantomData)),
+            #[cfg(not(target_arch = "x86_64"))]
             SimdLevel::Avx512 => Avx512::within(Run::<K, Wide<16, Avx512>>(kernel, PhantomData)),
             SimdLevel::Neon => Neon::within(Run::<K, Wide<4, Neon>>(kernel, PhantomData)),
         };

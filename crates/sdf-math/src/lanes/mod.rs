@@ -1,6 +1,7 @@
 //! The number type the distance formulas are written over: [`Lane`] is `f32` for the
-//! scalar tracer and [`Wide`] (N `f32` lanes under one instruction set) for a SIMD
-//! tracer, so that each primitive and operator has one definition that both evaluate.
+//! scalar tracer and a vector of `f32` lanes for a SIMD tracer ([`Wide`], N lanes under
+//! one instruction set, or on x86-64 one AVX2 or AVX-512 register, `x86.rs`), so that
+//! each primitive and operator has one definition that all of them evaluate.
 //!
 //! The contract every implementation meets: **each lane's result is, bit for bit, what
 //! `f32` gives for that lane's inputs**. That is why the trait has two kinds of minimum
@@ -12,6 +13,8 @@
 mod dispatch;
 mod vec;
 mod wide;
+#[cfg(target_arch = "x86_64")]
+mod x86;
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 

@@ -1,13 +1,16 @@
 //! [`Wide`]: `N` lanes of `f32`, each operation the `f32` one applied lane by lane, in a
-//! loop the compiler turns into vector instructions of the instruction set `I`.
+//! loop the compiler turns into vector instructions of the instruction set `I`: the lane
+//! type of the portable, SSE and NEON levels. AVX2 and AVX-512 on x86-64 have lane types
+//! whose operations are instructions themselves (`x86.rs`), because LLVM turned these
+//! loops into a mix of widths there.
 //!
-//! Writing each lane's operation as the scalar one, rather than as intrinsics, is what
-//! makes the bit-identity contract hold by construction: the vector unit's add, multiply,
-//! divide, square root, compare and blend round exactly as the scalar unit does, and the
-//! compiler never fuses a multiply and an add on its own. The instruction set comes from
-//! where the code runs: [`SimdLevel::dispatch`](super::SimdLevel::dispatch) enters a
-//! function compiled with `I`'s target features (through `pulp`, safely), and what is
-//! inlined into it runs with them.
+//! Writing each lane's operation as the scalar one makes the bit-identity contract hold
+//! by construction: the vector unit's add, multiply, divide, square root, compare and
+//! blend round exactly as the scalar unit does, and the compiler never fuses a multiply
+//! and an add on its own. The instruction set comes from where the code runs:
+//! [`SimdLevel::dispatch`](super::SimdLevel::dispatch) enters a function compiled with
+//! `I`'s target features (through `pulp`, safely), and what is inlined into it runs with
+//! them.
 
 use std::fmt;
 use std::marker::PhantomData;
@@ -218,10 +221,11 @@ fn bits_from<T: MaskLane>(lanes: &[T], first: usize) -> u32 {
 
 /// All ones or all zeros per lane: what SSE, AVX2 and NEON compares write and their
 /// blends (or `and`, `andnot`, `or`) read. A select moves each lane's bits unchanged, as
-/// the scalar select does. AVX-512 takes this form too: LLVM moves it to and from the
-/// mask registers where an instruction needs them. On the Intel Xeon measured, its 16
-/// lanes rendered at 1.09-1.15x AVX2's speed with it, and at 0.92-0.99x with a `bool`
-/// per lane (docs/PERFORMANCE.md, "Sixteen lanes with bit masks").
+/// the scalar select does. `Wide`'s AVX-512 takes this form too, LLVM moving it to and
+/// from the mask registers where an instruction needs them: on the Intel Xeon measured,
+/// its 16 lanes rendered at 1.09-1.15x AVX2's speed with it, and at 0.92-0.99x with a
+/// `bool` per lane (docs/PERFORMANCE.md, "Sixteen lanes with bit masks"). On x86-64 the
+/// AVX-512 level runs `x86.rs`'s `Zmm` instead, whose masks are the mask registers.
 impl MaskLane for u32 {
     #[inline(always)]
     fn from_bool(b: bool) -> u32 {
