@@ -181,6 +181,26 @@ pub fn run(binary: Option<&Path>, floor: f64) -> Result<()> {
         LEVELS.map(|(_, symbol, _)| symbol).join("` or `")
     );
     md.push_str(&largest);
+    let called = out_of_line_intrinsics(&listing);
+    writeln!(
+        md,
+        "\nAVX and AVX-512 intrinsics called out of line (each a call per vector operation, \
+         from code compiled without their features): {}",
+        if called.is_empty() {
+            "none"
+        } else {
+            "**some**"
+        }
+    )?;
+    for (intrinsic, callers) in &called {
+        writeln!(md, "- `{intrinsic}`, from `{}`", callers.join("`, `"))?;
+        failures.push(format!(
+            "{intrinsic} is called out of line, from {}: code that runs a lane type's \
+             operations in a function compiled without its features (run it through \
+             `Lane::apart`, or inline it into the kernel)",
+            callers.join(", ")
+        ));
+    }
     if own {
         write_report(false, "CODEGEN.md", &md)?;
     } else {
@@ -300,6 +320,39 @@ fn kernels(listing: &str, symbol: &str) -> Vec<Kernel> {
     }
     kernels.extend(current);
     kernels
+}
+
+/// The 256- and 512-bit intrinsics that `listing` holds as functions of their own, each
+/// with the functions that call it. `x86.rs`'s lane types are meant to be inlined into
+/// code compiled with their features; a function of theirs left out of line is compiled
+/// for the baseline, which cannot inline the intrinsics and calls each one: the union of
+/// 8 spheres evaluated 6 to 10x slower so (docs/PERFORMANCE.md, "Explicit vector
+/// operations").
+fn out_of_line_intrinsics(listing: &str) -> BTreeMap<String, Vec<String>> {
+    let is_intrinsic = |name: &str| {
+        name.starts_with("core::core_arch::x86")
+            && (name.contains("::_mm256_") || name.contains("::_mm512_"))
+    };
+    let mut called: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    let mut current = "";
+    for line in listing.lines() {
+        if let Some((_, name)) = function_header(line) {
+            current = name;
+            continue;
+        }
+        let Some(target) = line.split_once('<').and_then(|(before, after)| {
+            before.contains("call").then(|| after.trim_end_matches('>'))
+        }) else {
+            continue;
+        };
+        if is_intrinsic(target) && !is_intrinsic(current) {
+            let callers = called.entry(target.to_owned()).or_default();
+            if !callers.iter().any(|c| c == current) {
+                callers.push(current.to_owned());
+            }
+        }
+    }
+    called
 }
 
 /// `0000000000012340 <name>:` as its address and name.

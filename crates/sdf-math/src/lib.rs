@@ -20,8 +20,8 @@
 //!
 //! What this crate deliberately is not: no materials, no lights, no cameras, no I/O and no
 //! printing. It never panics on finite input and uses `f32` throughout (glam [`Vec3`],
-//! [`Quat`]). Its one `unsafe`, the workspace's only one, makes pulp's AVX2 and AVX-512
-//! tokens without a check the dispatch has already made (`lanes/x86.rs` argues why). Formulas follow Inigo Quilez's articles at iquilezles.org
+//! [`Quat`]). Its `unsafe`, the workspace's only, makes pulp's AVX2 and AVX-512 tokens
+//! without a check the dispatch has already made (`lanes/x86.rs` argues why). Formulas follow Inigo Quilez's articles at iquilezles.org
 //! ("distfunctions", "smin", "normalsSDF") and Hart's "Sphere tracing" (1996).
 //!
 //! Tracing a ray against a torus, with no integrator in sight:

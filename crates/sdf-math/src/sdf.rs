@@ -4,7 +4,7 @@ use glam::{Quat, Vec3};
 
 use crate::DistanceField;
 use crate::blend::{smooth_max_lanes, smooth_min_lanes};
-use crate::lanes::{Lane, LaneDistance, LaneVec3};
+use crate::lanes::{Lane, LaneDistance, LaneVec3, Task};
 use crate::primitives::Primitive;
 
 /// A signed distance function as a closed enum tree: evaluation is a `match`, never a
@@ -222,54 +222,72 @@ impl LaneDistance for Sdf {
     fn distance_lanes<L: Lane>(&self, p: LaneVec3<L>) -> L {
         match self {
             Self::Primitive(shape) => shape.distance_lanes(p),
-            _ => self.node_distance_apart(&p),
+            _ => L::apart(NodeDistance { sdf: self, p }),
         }
     }
 }
 
 impl Sdf {
-    /// [`Sdf::node_distance`], called apart: marked cold so that a kernel marching
-    /// primitives keeps the point in registers. Otherwise the compiler may store the point's
-    /// vectors for this call before the branch, on every evaluation, and the primitive's
-    /// loads wait on those stores (docs/PERFORMANCE.md, "Stores loaded whole").
-    #[cold]
-    #[inline(never)]
-    fn node_distance_apart<L: Lane>(&self, p: &LaneVec3<L>) -> L {
-        self.node_distance(*p)
-    }
-
-    #[inline]
+    /// An interior node's distance over its children. Loops, not closures, so that all of
+    /// it is inlined into the function [`Lane::apart`] compiles for the level.
+    #[inline(always)]
     fn node_distance<L: Lane>(&self, p: LaneVec3<L>) -> L {
         let inf = L::splat(f32::INFINITY);
         match self {
             Self::Primitive(shape) => shape.distance_lanes(p),
-            Self::Union(children) => children.iter().fold(inf, |m, c| m.min(c.distance_lanes(p))),
-            Self::Intersection(children) => children
-                .iter()
-                .fold(-inf, |m, c| m.max(c.distance_lanes(p))),
+            Self::Union(children) => {
+                let mut d = inf;
+                for c in children {
+                    d = d.min(c.distance_lanes(p));
+                }
+                d
+            }
+            Self::Intersection(children) => {
+                let mut d = -inf;
+                for c in children {
+                    d = d.max(c.distance_lanes(p));
+                }
+                d
+            }
             Self::Difference(children) => match children.split_first() {
                 None => inf,
-                Some((first, rest)) => rest
-                    .iter()
-                    .fold(first.distance_lanes(p), |m, c| m.max(-c.distance_lanes(p))),
+                Some((first, rest)) => {
+                    let mut d = first.distance_lanes(p);
+                    for c in rest {
+                        d = d.max(-c.distance_lanes(p));
+                    }
+                    d
+                }
             },
             Self::SmoothUnion { k, children } => match children.split_first() {
                 None => inf,
-                Some((first, rest)) => rest.iter().fold(first.distance_lanes(p), |m, c| {
-                    smooth_min_lanes(m, c.distance_lanes(p), *k)
-                }),
+                Some((first, rest)) => {
+                    let mut d = first.distance_lanes(p);
+                    for c in rest {
+                        d = smooth_min_lanes(d, c.distance_lanes(p), *k);
+                    }
+                    d
+                }
             },
             Self::SmoothIntersection { k, children } => match children.split_first() {
                 None => -inf,
-                Some((first, rest)) => rest.iter().fold(first.distance_lanes(p), |m, c| {
-                    smooth_max_lanes(m, c.distance_lanes(p), *k)
-                }),
+                Some((first, rest)) => {
+                    let mut d = first.distance_lanes(p);
+                    for c in rest {
+                        d = smooth_max_lanes(d, c.distance_lanes(p), *k);
+                    }
+                    d
+                }
             },
             Self::SmoothDifference { k, children } => match children.split_first() {
                 None => inf,
-                Some((first, rest)) => rest.iter().fold(first.distance_lanes(p), |m, c| {
-                    smooth_max_lanes(m, -c.distance_lanes(p), *k)
-                }),
+                Some((first, rest)) => {
+                    let mut d = first.distance_lanes(p);
+                    for c in rest {
+                        d = smooth_max_lanes(d, -c.distance_lanes(p), *k);
+                    }
+                    d
+                }
             },
             Self::Translate { offset, child } => child.distance_lanes(p - LaneVec3::splat(*offset)),
             Self::Rotate { rotation, child } => {
@@ -283,6 +301,24 @@ impl Sdf {
                 }
             }
         }
+    }
+}
+
+/// [`Sdf::node_distance`] as a [`Task`], run apart ([`Lane::apart`]): cold and out of
+/// line, so that a kernel marching primitives keeps the point in registers. Otherwise the
+/// compiler may store the point's vectors for this call before the branch, on every
+/// evaluation, and the primitive's loads wait on those stores (docs/PERFORMANCE.md,
+/// "Stores loaded whole").
+struct NodeDistance<'a, L> {
+    sdf: &'a Sdf,
+    p: LaneVec3<L>,
+}
+
+impl<L: Lane> Task for NodeDistance<'_, L> {
+    type Output = L;
+    #[inline(always)]
+    fn run(self) -> L {
+        self.sdf.node_distance(self.p)
     }
 }
 

@@ -84,12 +84,29 @@ pub trait Lane:
     /// `if mask { if_true } else { if_false }`, per lane.
     fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
 
+    /// Runs `task` out of line: in a function of its own, cold and never inlined, that
+    /// is compiled for this lane type's instruction set. For work a kernel keeps apart
+    /// (the interior nodes of an `Sdf` tree) so that its own registers stay free. A plain
+    /// function out of line would be compiled for the baseline: there `Wide`'s loops run
+    /// as baseline code, but each of `x86.rs`'s operations would be a call.
+    #[inline(always)]
+    fn apart<T: Task>(task: T) -> T::Output {
+        run_apart(task)
+    }
+
     /// Where the lane is finite: zero times an infinity or a NaN is NaN, which no
     /// comparison holds.
     #[inline(always)]
     fn finite(self) -> Self::Mask {
         (self * Self::splat(0.0)).ge(Self::splat(0.0))
     }
+}
+
+/// [`Lane::apart`] for the lane types whose instructions the baseline has.
+#[cold]
+#[inline(never)]
+fn run_apart<T: Task>(task: T) -> T::Output {
+    task.run()
 }
 
 /// Work handed to [`Isa::within`]: a struct, not a closure, because

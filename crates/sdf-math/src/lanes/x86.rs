@@ -15,25 +15,33 @@
 //! minima, maxima and clamps are the scalar's compares and selects, not `vminps`, whose
 //! NaN and signed-zero rules are x86's own.
 //!
-//! # The one `unsafe`
+//! # The `unsafe`, the workspace's only
 //! pulp's methods need its token, which only a feature check makes safely. The check is
 //! a relaxed atomic load and a branch that LLVM can neither merge nor hoist out of a
 //! loop; with it in every [`Lane::splat`] and [`Lane::load`], the shipped scenes rendered
 //! at 0.83-0.87x the speed (the same docs section). So [`v4`] and [`v3`] make the token
-//! unchecked, under this invariant: a `Zmm` or `Ymm` value, and so any call of their
-//! methods, exists only inside [`Avx512::within`](super::Avx512) or
+//! unchecked, and [`Lane::apart`] calls a function compiled with the token's features
+//! ([`apart_v4`], [`apart_v3`]), under one invariant: a `Zmm` or `Ymm` value, and so any
+//! call of their methods, exists only inside [`Avx512::within`](super::Avx512) or
 //! [`Avx2::within`](super::Avx2), which run their task only after pulp's own check of
 //! the same token passed. The types are private to this crate, and
 //! [`SimdLevel::dispatch`](super::SimdLevel::dispatch) is the only code that names them.
 //! CPU features are the machine's, not the thread's, so a value moved to another thread
 //! stays valid.
+//!
+//! # Everything inlined, or apart
+//! An operation here is an intrinsic compiled with the level's features. Code that uses
+//! it out of line, in a function compiled for the baseline, cannot inline it and calls
+//! it, once per operation: the union of 8 spheres evaluated 6 to 10x slower so. So kernels
+//! inline what they call, as for `Wide`, and what they keep out of line goes through
+//! [`Lane::apart`]. `cargo xtask codegen` fails on any such intrinsic left out of line.
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use pulp::x86::{V3, V4};
 use pulp::{b16, f32x8, f32x16, m32x8};
 
-use super::Lane;
+use super::{Lane, Task};
 
 /// pulp's AVX-512 token. See the module notes for why it is sound.
 #[inline(always)]
@@ -53,6 +61,26 @@ fn v3() -> V3 {
     // SAFETY: only reached from code that `Avx2::within` runs, after `V3::try_new`
     // succeeded (module notes).
     unsafe { V3::new_unchecked() }
+}
+
+/// [`Lane::apart`] for `Zmm`: out of line, with exactly pulp's `V4` features.
+#[cold]
+#[inline(never)]
+#[target_feature(
+    enable = "sse,sse2,fxsr,sse3,ssse3,sse4.1,sse4.2,popcnt,avx,avx2,bmi1,bmi2,fma,lzcnt,avx512f,avx512bw,avx512cd,avx512dq,avx512vl"
+)]
+fn apart_v4<T: Task>(task: T) -> T::Output {
+    task.run()
+}
+
+/// [`Lane::apart`] for `Ymm`: out of line, with exactly pulp's `V3` features.
+#[cold]
+#[inline(never)]
+#[target_feature(
+    enable = "sse,sse2,fxsr,sse3,ssse3,sse4.1,sse4.2,popcnt,avx,avx2,bmi1,bmi2,fma,lzcnt"
+)]
+fn apart_v3<T: Task>(task: T) -> T::Output {
+    task.run()
 }
 
 /// The sign bit of an `f32`: what `-x` flips.
@@ -183,6 +211,14 @@ impl Lane for Zmm {
     shared!(Zmm, 16);
 
     #[inline(always)]
+    #[allow(unsafe_code)]
+    fn apart<T: Task>(task: T) -> T::Output {
+        // SAFETY: as for `v4`: a `Zmm` exists, so the CPU has pulp's `V4` features, which
+        // are `apart_v4`'s.
+        unsafe { apart_v4(task) }
+    }
+
+    #[inline(always)]
     fn splat(value: f32) -> Zmm {
         Zmm(v4().splat_f32x16(value))
     }
@@ -251,6 +287,14 @@ impl Lane for Zmm {
 impl Lane for Ymm {
     type Mask = m32x8;
     shared!(Ymm, 8);
+
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    fn apart<T: Task>(task: T) -> T::Output {
+        // SAFETY: as for `v3`: a `Ymm` exists, so the CPU has pulp's `V3` features, which
+        // are `apart_v3`'s.
+        unsafe { apart_v3(task) }
+    }
 
     #[inline(always)]
     fn splat(value: f32) -> Ymm {
