@@ -321,9 +321,9 @@ impl<F: StreamField> LaneKernel for PlainStream<'_, F> {
                 (xs[lane], ys[lane], zs[lane]) = (p.x, p.y, p.z);
             }
             let p = LaneVec3::new(
-                L::load(&xs[..lanes]),
-                L::load(&ys[..lanes]),
-                L::load(&zs[..lanes]),
+                L::assemble(&xs[..lanes]),
+                L::assemble(&ys[..lanes]),
+                L::assemble(&zs[..lanes]),
             );
             self.field.distance_lanes(p).store(&mut d[..lanes]);
             for lane in 0..lanes {

@@ -46,6 +46,13 @@ pub trait Lane:
     fn load(values: &[f32]) -> Self;
     /// The first `out.len()` lanes (at most [`Lane::LANES`]) into `out`.
     fn store(self, out: &mut [f32]);
+    /// [`Lane::load`] of values just written one lane at a time: built in registers
+    /// where a whole-vector load would wait for those single stores (a failed store
+    /// forward). The same lanes as `load`.
+    #[inline(always)]
+    fn assemble(values: &[f32]) -> Self {
+        Self::load(values)
+    }
 
     /// Square root, correctly rounded.
     fn sqrt(self) -> Self;
@@ -270,9 +277,9 @@ mod tests {
         }
     }
 
-    /// Compares, their combinations, `bits`, `any` and `select` on every level, whatever
-    /// form its masks take (`Isa::Mask`), against the scalar lane by lane: signed zeros,
-    /// infinities and NaNs included, in every lane position.
+    /// `assemble` as `load`; compares, their combinations, `bits`, `any` and `select` on
+    /// every level, whatever form its masks take, against the scalar lane by lane: signed
+    /// zeros, infinities and NaNs included, in every lane position.
     struct Masks<'a> {
         a: &'a [f32],
         b: &'a [f32],
@@ -288,6 +295,16 @@ mod tests {
             let n = L::LANES;
             for (a, b) in self.a.chunks(n).zip(self.b.chunks(n)) {
                 let (va, vb) = (L::load(a), L::load(b));
+                let (mut loaded, mut assembled) = (vec![0f32; n], vec![0f32; n]);
+                va.store(&mut loaded);
+                L::assemble(a).store(&mut assembled);
+                if loaded
+                    .iter()
+                    .zip(&assembled)
+                    .any(|(x, y)| x.to_bits() != y.to_bits())
+                {
+                    wrong.push(format!("assemble {assembled:?} vs load {loaded:?}"));
+                }
                 let masks = [
                     va.lt(vb),
                     va.gt(vb),

@@ -219,6 +219,15 @@ impl Lane for Zmm {
     }
 
     #[inline(always)]
+    fn assemble(values: &[f32]) -> Zmm {
+        let v = lanes_from::<16>(values);
+        Zmm(pulp::cast(v4().avx512f._mm512_setr_ps(
+            v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13],
+            v[14], v[15],
+        )))
+    }
+
+    #[inline(always)]
     fn splat(value: f32) -> Zmm {
         Zmm(v4().splat_f32x16(value))
     }
@@ -294,6 +303,14 @@ impl Lane for Ymm {
         // SAFETY: as for `v3`: a `Ymm` exists, so the CPU has pulp's `V3` features, which
         // are `apart_v3`'s.
         unsafe { apart_v3(task) }
+    }
+
+    #[inline(always)]
+    fn assemble(values: &[f32]) -> Ymm {
+        let v = lanes_from::<8>(values);
+        Ymm(pulp::cast(v3().avx._mm256_setr_ps(
+            v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
+        )))
     }
 
     #[inline(always)]
