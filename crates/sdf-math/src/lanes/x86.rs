@@ -158,10 +158,64 @@ fn lanes_into<const N: usize>(lanes: [f32; N], out: &mut [f32]) {
     }
 }
 
-/// The [`Lane`] methods both types write alike, over their own compares and selects.
+/// The [`Lane`] methods both types write alike: over their token (`$token`), the
+/// function their work apart runs in (`$apart`) and pulp's name for each operation on
+/// their vector.
 macro_rules! shared {
-    ($lanes:ident, $n:literal) => {
+    (
+        $lanes:ident, $n:literal, $token:ident, $apart:ident,
+        $splat:ident, $sqrt:ident, $abs:ident, $lt:ident, $gt:ident, $ge:ident,
+        $is_nan:ident, $select:ident
+    ) => {
         const LANES: usize = $n;
+
+        #[inline(always)]
+        #[allow(unsafe_code)]
+        fn apart<T: Task>(task: T) -> T::Output {
+            // SAFETY: as for the token: a value of this type exists, so the CPU has the
+            // token's features, which are exactly the function's.
+            unsafe { $apart(task) }
+        }
+
+        #[inline(always)]
+        fn splat(value: f32) -> $lanes {
+            $lanes($token().$splat(value))
+        }
+
+        #[inline(always)]
+        fn sqrt(self) -> $lanes {
+            $lanes($token().$sqrt(self.0))
+        }
+
+        #[inline(always)]
+        fn abs(self) -> $lanes {
+            $lanes($token().$abs(self.0))
+        }
+
+        #[inline(always)]
+        fn lt(self, other: $lanes) -> Self::Mask {
+            $token().$lt(self.0, other.0)
+        }
+
+        #[inline(always)]
+        fn gt(self, other: $lanes) -> Self::Mask {
+            $token().$gt(self.0, other.0)
+        }
+
+        #[inline(always)]
+        fn ge(self, other: $lanes) -> Self::Mask {
+            $token().$ge(self.0, other.0)
+        }
+
+        #[inline(always)]
+        fn is_nan(self) -> Self::Mask {
+            $token().$is_nan(self.0)
+        }
+
+        #[inline(always)]
+        fn select(mask: Self::Mask, if_true: $lanes, if_false: $lanes) -> $lanes {
+            $lanes($token().$select(mask, if_true.0, if_false.0))
+        }
 
         #[inline(always)]
         fn load(values: &[f32]) -> $lanes {
@@ -208,15 +262,20 @@ macro_rules! shared {
 
 impl Lane for Zmm {
     type Mask = b16;
-    shared!(Zmm, 16);
-
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    fn apart<T: Task>(task: T) -> T::Output {
-        // SAFETY: as for `v4`: a `Zmm` exists, so the CPU has pulp's `V4` features, which
-        // are `apart_v4`'s.
-        unsafe { apart_v4(task) }
-    }
+    shared!(
+        Zmm,
+        16,
+        v4,
+        apart_v4,
+        splat_f32x16,
+        sqrt_f32x16,
+        abs_f32x16,
+        cmp_lt_f32x16,
+        cmp_gt_f32x16,
+        cmp_ge_f32x16,
+        is_nan_f32x16,
+        select_f32x16
+    );
 
     #[inline(always)]
     fn assemble(values: &[f32]) -> Zmm {
@@ -225,41 +284,6 @@ impl Lane for Zmm {
             v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13],
             v[14], v[15],
         )))
-    }
-
-    #[inline(always)]
-    fn splat(value: f32) -> Zmm {
-        Zmm(v4().splat_f32x16(value))
-    }
-
-    #[inline(always)]
-    fn sqrt(self) -> Zmm {
-        Zmm(v4().sqrt_f32x16(self.0))
-    }
-
-    #[inline(always)]
-    fn abs(self) -> Zmm {
-        Zmm(v4().abs_f32x16(self.0))
-    }
-
-    #[inline(always)]
-    fn lt(self, other: Zmm) -> b16 {
-        v4().cmp_lt_f32x16(self.0, other.0)
-    }
-
-    #[inline(always)]
-    fn gt(self, other: Zmm) -> b16 {
-        v4().cmp_gt_f32x16(self.0, other.0)
-    }
-
-    #[inline(always)]
-    fn ge(self, other: Zmm) -> b16 {
-        v4().cmp_ge_f32x16(self.0, other.0)
-    }
-
-    #[inline(always)]
-    fn is_nan(self) -> b16 {
-        v4().is_nan_f32x16(self.0)
     }
 
     #[inline(always)]
@@ -286,24 +310,24 @@ impl Lane for Zmm {
     fn bits(mask: b16) -> u32 {
         u32::from(mask.0)
     }
-
-    #[inline(always)]
-    fn select(mask: b16, if_true: Zmm, if_false: Zmm) -> Zmm {
-        Zmm(v4().select_f32x16(mask, if_true.0, if_false.0))
-    }
 }
 
 impl Lane for Ymm {
     type Mask = m32x8;
-    shared!(Ymm, 8);
-
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    fn apart<T: Task>(task: T) -> T::Output {
-        // SAFETY: as for `v3`: a `Ymm` exists, so the CPU has pulp's `V3` features, which
-        // are `apart_v3`'s.
-        unsafe { apart_v3(task) }
-    }
+    shared!(
+        Ymm,
+        8,
+        v3,
+        apart_v3,
+        splat_f32x8,
+        sqrt_f32x8,
+        abs_f32x8,
+        cmp_lt_f32x8,
+        cmp_gt_f32x8,
+        cmp_ge_f32x8,
+        is_nan_f32x8,
+        select_f32x8
+    );
 
     #[inline(always)]
     fn assemble(values: &[f32]) -> Ymm {
@@ -311,41 +335,6 @@ impl Lane for Ymm {
         Ymm(pulp::cast(v3().avx._mm256_setr_ps(
             v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
         )))
-    }
-
-    #[inline(always)]
-    fn splat(value: f32) -> Ymm {
-        Ymm(v3().splat_f32x8(value))
-    }
-
-    #[inline(always)]
-    fn sqrt(self) -> Ymm {
-        Ymm(v3().sqrt_f32x8(self.0))
-    }
-
-    #[inline(always)]
-    fn abs(self) -> Ymm {
-        Ymm(v3().abs_f32x8(self.0))
-    }
-
-    #[inline(always)]
-    fn lt(self, other: Ymm) -> m32x8 {
-        v3().cmp_lt_f32x8(self.0, other.0)
-    }
-
-    #[inline(always)]
-    fn gt(self, other: Ymm) -> m32x8 {
-        v3().cmp_gt_f32x8(self.0, other.0)
-    }
-
-    #[inline(always)]
-    fn ge(self, other: Ymm) -> m32x8 {
-        v3().cmp_ge_f32x8(self.0, other.0)
-    }
-
-    #[inline(always)]
-    fn is_nan(self) -> m32x8 {
-        v3().is_nan_f32x8(self.0)
     }
 
     #[inline(always)]
@@ -372,10 +361,5 @@ impl Lane for Ymm {
     #[inline(always)]
     fn bits(mask: m32x8) -> u32 {
         v3().avx._mm256_movemask_ps(pulp::cast(mask)) as u32
-    }
-
-    #[inline(always)]
-    fn select(mask: m32x8, if_true: Ymm, if_false: Ymm) -> Ymm {
-        Ymm(v3().select_f32x8(mask, if_true.0, if_false.0))
     }
 }
