@@ -5,10 +5,10 @@
 
 use glam::Vec3;
 use lueur_sdf_math::{
-    Aabb, BoundingSphere, DistanceField, HalfSpace, Lane, LaneDistance, LaneKernel, LaneVec3,
-    MAX_LANES, OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClipLanes, Sdf, SimdLevel,
-    StreamField, TraceOutcome, TraceParams, fill_lane_groups, sphere_trace,
-    sphere_trace_relaxed_stream_of,
+    Aabb, BoundingSphere, DistanceField, GroupField, GroupRays, HalfSpace, Lane, LaneDistance,
+    LaneKernel, LaneVec3, MAX_LANES, OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClipLanes,
+    Sdf, SimdLevel, StreamField, TraceOutcome, TraceParams, fill_lane_groups, sphere_trace,
+    sphere_trace_relaxed_group, sphere_trace_relaxed_stream_of,
 };
 
 use lueur_scene::{Marching, Object};
@@ -31,7 +31,30 @@ pub(crate) struct Geometry {
     /// objects checked without their box first, so that the running minimum is small
     /// when the boxes are checked, then the others, each group in scene order.
     order: Vec<Ordered>,
+    /// How fast marching schedules a stream's rays on the vectors.
+    schedule: Schedule,
 }
+
+/// How [`Geometry::march`] puts a stream's rays on the vectors; both give each ray the
+/// same outcome, bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Schedule {
+    /// Each lane takes the next ray as soon as its own ends ([`sphere_trace_relaxed_stream_of`]):
+    /// full vectors whatever the mix of short and long marches, for the price of each ray's
+    /// state written into its lane and its candidates listed.
+    Stream,
+    /// A vector of rays clipped and marched together until the last ends, the candidates
+    /// as lane masks, the state in registers ([`sphere_trace_relaxed_group`]): no per-ray
+    /// work, but a lane whose ray ends early idles. For scenes of at most
+    /// [`MAX_GROUP_OBJECTS`] objects whose bounds are the objects themselves or close to
+    /// them (boxes, spheres, planes), where the rays of a vector take about as many
+    /// steps.
+    Groups,
+}
+
+/// The most objects a scene marched in [`Schedule::Groups`] may have: each keeps a lane
+/// mask in the kernel.
+const MAX_GROUP_OBJECTS: usize = 32;
 
 /// An object at its place in [`Geometry::order`], with what the vector kernels read of
 /// it there, so that they walk one array.
@@ -125,6 +148,9 @@ pub(crate) struct MarchBatch {
     /// While marching, [`CandidateLanes`]'s `member` and `members`.
     member: Vec<[f32; MAX_LANES]>,
     members: Vec<u32>,
+    /// In [`Schedule::Groups`], per group of queued rays a vector holds, their rays and
+    /// parameters as rows of lanes ([`GROUP_ROWS`]).
+    group_rows: Vec<[[f32; MAX_LANES]; GROUP_ROWS]>,
 }
 
 impl MarchBatch {
@@ -169,9 +195,100 @@ impl MarchBatch {
 /// the parameters `eps_abs`, `eps_rel`, `t_min`, `t_max`.
 const CLIP_ROWS: usize = 10;
 
+/// Rows of a group of rays in [`MarchBatch::group_rows`]: [`CLIP_ROWS`]'s, then the step
+/// cap.
+const GROUP_ROWS: usize = CLIP_ROWS + 1;
+
 /// Objects per row of [`MarchBatch::kept`]: sums of distinct powers of two are exact in
 /// `f32` below `2^24`.
 const OBJECTS_PER_MASK: usize = 24;
+
+/// Each lane's ray of `clip` against `entry`'s bound: the interval kept and the lanes
+/// that keep it, or `None` where a box keeps none of the lanes in `live` (lane `i` in bit
+/// `i`).
+#[inline(always)]
+fn clip_entry<L: Lane>(
+    entry: &Ordered,
+    clip: &RayClipLanes<L>,
+    live: u32,
+    (t_min, t_max): (L, L),
+) -> Option<(L, L, L::Mask)> {
+    Some(match &entry.bound {
+        ObjectBound::Box { aabb, sphere, .. } => {
+            let (t0, t1, keep) = clip.clip_box_lanes_in(aabb, live)?;
+            match sphere {
+                Some(sphere) => {
+                    let (s0, s1, inside) = clip.clip_sphere_lanes(sphere);
+                    let (t0, t1) = (t0.max(s0), t1.min(s1));
+                    (t0, t1, L::and(L::and(keep, inside), L::not(t0.gt(t1))))
+                }
+                None => (t0, t1, keep),
+            }
+        }
+        ObjectBound::Sphere(sphere) => clip.clip_sphere_lanes(sphere),
+        ObjectBound::HalfSpace(h) => clip.clip_half_space_lanes(h),
+        ObjectBound::Everywhere => (t_min, t_max, L::splat(0.0).lt(L::splat(1.0))),
+    })
+}
+
+/// The range each lane's kept objects cover so far: the first kept object's interval,
+/// then each one's union with it, as `f32::min` and `f32::max` take it; valid where
+/// `seen`.
+struct Covered<L: Lane> {
+    lo: L,
+    hi: L,
+    seen: L::Mask,
+}
+
+impl<L: Lane> Covered<L> {
+    #[inline(always)]
+    fn new() -> Covered<L> {
+        let zero = L::splat(0.0);
+        Covered {
+            lo: zero,
+            hi: zero,
+            seen: zero.gt(zero),
+        }
+    }
+
+    #[inline(always)]
+    fn add(&mut self, (t0, t1, keep): (L, L, L::Mask)) {
+        self.lo = L::select(keep, L::select(self.seen, self.lo.min(t0), t0), self.lo);
+        self.hi = L::select(keep, L::select(self.seen, self.hi.max(t1), t1), self.hi);
+        self.seen = L::or(self.seen, keep);
+    }
+}
+
+/// One object's part in the union of each lane's candidates at `p` (the lanes of
+/// `active`): the running minimum `d` and the object it came from, `nearest`. A culled
+/// box is checked first: at most as far as its object (its contract), where it is already
+/// farther than the running minimum the object cannot lower it.
+#[inline(always)]
+fn lower_by<L: Lane>(
+    entry: &Ordered,
+    mut active: L::Mask,
+    p: LaneVec3<L>,
+    d: &mut L,
+    nearest: &mut L,
+) {
+    if let ObjectBound::Box {
+        aabb, cull: true, ..
+    } = &entry.bound
+    {
+        let beyond = L::and(
+            d.gt(L::splat(0.0)),
+            aabb.distance_squared_lanes(p).ge(*d * *d),
+        );
+        active = L::and(active, L::not(beyond));
+        if !L::any(active) {
+            return;
+        }
+    }
+    let f = entry.prepared.distance_lanes(p);
+    let lower = L::and(active, f.lt(*d));
+    *d = L::select(lower, f, *d);
+    *nearest = L::select(lower, L::splat(entry.id), *nearest);
+}
 
 /// The kernel that clips the queued rays of a [`MarchBatch`] against every object's bound,
 /// a ray per lane, and keeps each ray's candidates and the range they cover.
@@ -221,42 +338,25 @@ impl LaneKernel for Clip<'_> {
                 LaneVec3::new(L::load(row(3)), L::load(row(4)), L::load(row(5))),
                 [L::load(row(6)), L::load(row(7)), t_min, t_max],
             );
-            // Per lane: the range the kept objects cover so far (`lo`, `hi`, valid where
-            // `seen`: the first kept object's interval, then each one's union with it,
-            // as `f32::min` and `f32::max` take it), and the candidates kept, in order.
+            // Per lane: the range the kept objects cover, and the candidates kept, in order.
             let live = u32::MAX >> (32 - group.len());
-            let (mut lo, mut hi) = (L::splat(0.0), L::splat(0.0));
-            let mut seen = L::splat(0.0).gt(L::splat(0.0));
+            let mut covered = Covered::<L>::new();
             let chunks = geometry.order.chunks(OBJECTS_PER_MASK);
             for (entries, row) in chunks.zip(kept_rows.iter_mut()) {
                 // Each lane's candidates among these objects, in two vector operations per
                 // object: no per-lane work, whose branches would be as random as the rays.
                 let mut kept = L::splat(0.0);
                 for (j, entry) in entries.iter().enumerate() {
-                    let (t0, t1, keep) = match &entry.bound {
-                        ObjectBound::Box { aabb, sphere, .. } => {
-                            match (clip.clip_box_lanes_in(aabb, live), sphere) {
-                                (Some((t0, t1, keep)), Some(sphere)) => {
-                                    let (s0, s1, inside) = clip.clip_sphere_lanes(sphere);
-                                    let (t0, t1) = (t0.max(s0), t1.min(s1));
-                                    (t0, t1, L::and(L::and(keep, inside), L::not(t0.gt(t1))))
-                                }
-                                (Some(clip), None) => clip,
-                                // No ray of the group keeps the object.
-                                (None, _) => continue,
-                            }
-                        }
-                        ObjectBound::Sphere(sphere) => clip.clip_sphere_lanes(sphere),
-                        ObjectBound::HalfSpace(h) => clip.clip_half_space_lanes(h),
-                        ObjectBound::Everywhere => (t_min, t_max, L::splat(0.0).lt(L::splat(1.0))),
+                    let Some(interval) = clip_entry(entry, &clip, live, (t_min, t_max)) else {
+                        // No ray of the group keeps the object.
+                        continue;
                     };
-                    lo = L::select(keep, L::select(seen, lo.min(t0), t0), lo);
-                    hi = L::select(keep, L::select(seen, hi.max(t1), t1), hi);
-                    seen = L::or(seen, keep);
-                    kept = L::select(keep, kept + L::splat((1u32 << j) as f32), kept);
+                    kept = L::select(interval.2, kept + L::splat((1u32 << j) as f32), kept);
+                    covered.add(interval);
                 }
                 kept.store(&mut row[..lanes]);
             }
+            let Covered { lo, hi, seen } = covered;
             let (mut los, mut his) = ([0f32; MAX_LANES], [0f32; MAX_LANES]);
             lo.store(&mut los[..lanes]);
             hi.store(&mut his[..lanes]);
@@ -288,6 +388,127 @@ impl LaneKernel for Clip<'_> {
         }
         batch.kept = kept_rows;
         batch.clip_rows = rows;
+    }
+}
+
+/// The kernel of [`Schedule::Groups`]: each vector of queued rays clipped against every
+/// object's bound and marched through its candidates at once, to the end of its last ray.
+struct GroupMarch<'a> {
+    geometry: &'a Geometry,
+    batch: &'a mut MarchBatch,
+}
+
+impl LaneKernel for GroupMarch<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let GroupMarch { geometry, batch } = self;
+        let lanes = L::LANES.min(MAX_LANES);
+        let mut rows = std::mem::take(&mut batch.group_rows);
+        let records = batch.queued.iter().map(|(_, ray, p)| {
+            [
+                ray.origin.x,
+                ray.origin.y,
+                ray.origin.z,
+                ray.dir.x,
+                ray.dir.y,
+                ray.dir.z,
+                p.eps_abs,
+                p.eps_rel,
+                p.t_min,
+                p.t_max,
+                p.max_steps as f32,
+            ]
+        });
+        fill_lane_groups(records, lanes, &mut rows);
+        let index: [f32; MAX_LANES] = std::array::from_fn(|i| i as f32);
+        let mut outcomes = [TraceOutcome::Miss { steps: 0 }; MAX_LANES];
+        let mut nearest = [0f32; MAX_LANES];
+        let mut start = 0;
+        for v in &rows {
+            let group = start..(start + lanes).min(batch.queued.len());
+            start = group.end;
+            let row = |i: usize| -> L { L::load(&v[i][..lanes]) };
+            let (origin, dir) = (
+                LaneVec3::new(row(0), row(1), row(2)),
+                LaneVec3::new(row(3), row(4), row(5)),
+            );
+            let (eps_abs, eps_rel, t_min, t_max) = (row(6), row(7), row(8), row(9));
+            let clip = RayClipLanes::from_lanes(origin, dir, [eps_abs, eps_rel, t_min, t_max]);
+            let live = u32::MAX >> (32 - group.len());
+            let mut field = GroupCandidates {
+                geometry,
+                keep: [L::splat(0.0).gt(L::splat(0.0)); MAX_GROUP_OBJECTS],
+                first: L::splat(0.0),
+                last: L::splat(0.0),
+            };
+            let mut covered = Covered::<L>::new();
+            for (k, entry) in geometry.order.iter().enumerate() {
+                if let Some(interval) = clip_entry(entry, &clip, live, (t_min, t_max)) {
+                    let first = L::and(interval.2, L::not(covered.seen));
+                    field.first = L::select(first, L::splat(entry.id), field.first);
+                    field.keep[k] = interval.2;
+                    covered.add(interval);
+                }
+            }
+            // Lanes past a short last group hold earlier rays: not marched.
+            let in_group = L::load(&index[..lanes]).lt(L::splat(group.len() as f32));
+            let marched = L::and(covered.seen, in_group);
+            let rays = GroupRays {
+                origin,
+                dir,
+                t_min: covered.lo,
+                t_max: covered.hi,
+                max_steps: row(10),
+                eps_abs,
+                eps_rel,
+                live: marched,
+            };
+            let ends =
+                sphere_trace_relaxed_group(&mut field, geometry.lipschitz, &rays, OVER_RELAXATION);
+            ends.store(&mut outcomes);
+            field.last.store(&mut nearest[..lanes]);
+            let marched = L::bits(marched);
+            for (lane, &(tag, _, _)) in batch.queued[group].iter().enumerate() {
+                if marched >> lane & 1 == 0 {
+                    batch.misses.push(tag);
+                } else {
+                    batch.tags.push(tag);
+                    batch.outcomes.push(outcomes[lane]);
+                    batch.nearest.push(nearest[lane] as u32);
+                }
+            }
+        }
+        batch.group_rows = rows;
+    }
+}
+
+/// The field of each lane's ray in a group: the union of its candidates, in the fixed
+/// order [`Geometry::order`], as [`CandidateLanes`] evaluates it for a stream.
+struct GroupCandidates<'a, L: Lane> {
+    geometry: &'a Geometry,
+    /// Per position in the order, the lanes whose ray has that object as a candidate.
+    keep: [L::Mask; MAX_GROUP_OBJECTS],
+    /// Per lane: its ray's first candidate, the nearest object before any is evaluated,
+    /// and the nearest object at its last evaluation (object indices, exact in f32).
+    first: L,
+    last: L,
+}
+
+impl<L: Lane> GroupField<L> for GroupCandidates<'_, L> {
+    #[inline(always)]
+    fn distance_lanes(&mut self, p: LaneVec3<L>, going: L::Mask) -> L {
+        let mut d = L::splat(f32::INFINITY);
+        let mut nearest = self.first;
+        for (entry, &keep) in self.geometry.order.iter().zip(&self.keep) {
+            let active = L::and(keep, going);
+            if L::any(active) {
+                lower_by(entry, active, p, &mut d, &mut nearest);
+            }
+        }
+        self.last = L::select(going, nearest, self.last);
+        d
     }
 }
 
@@ -382,23 +603,13 @@ impl StreamField for CandidateLanes<'_> {
             if members == 0 {
                 continue;
             }
-            let mut active = L::load(&member[..lanes]).gt(zero);
-            // The box is at most as far as the object (its contract): where it is already
-            // farther than the running minimum, the object cannot lower it.
-            if let ObjectBound::Box {
-                aabb, cull: true, ..
-            } = &entry.bound
-            {
-                let beyond = L::and(d.gt(zero), aabb.distance_squared_lanes(p).ge(d * d));
-                active = L::and(active, L::not(beyond));
-                if !L::any(active) {
-                    continue;
-                }
-            }
-            let f = entry.prepared.distance_lanes(p);
-            let lower = L::and(active, f.lt(d));
-            d = L::select(lower, f, d);
-            nearest = L::select(lower, L::splat(entry.id), nearest);
+            lower_by(
+                entry,
+                L::load(&member[..lanes]).gt(zero),
+                p,
+                &mut d,
+                &mut nearest,
+            );
         }
         nearest.store(&mut self.last[..lanes]);
         d
@@ -448,6 +659,19 @@ impl Geometry {
         for (k, entry) in order.iter().enumerate() {
             position[entry.object as usize] = k as u32;
         }
+        let close_bounds = order.iter().all(|entry| {
+            matches!(
+                entry.bound,
+                ObjectBound::Box { cull: false, .. }
+                    | ObjectBound::Sphere(_)
+                    | ObjectBound::HalfSpace(_)
+            )
+        });
+        let schedule = if close_bounds && order.len() <= MAX_GROUP_OBJECTS {
+            Schedule::Groups
+        } else {
+            Schedule::Stream
+        };
         Geometry {
             sdfs: objects.iter().map(|o| o.sdf.clone()).collect(),
             lipschitz,
@@ -455,7 +679,17 @@ impl Geometry {
             always,
             culled,
             order,
+            schedule,
         }
+    }
+
+    /// This geometry marched on `schedule` (when [`Schedule::Groups`], only for at most
+    /// [`MAX_GROUP_OBJECTS`] objects), for the tests that hold the two to the same
+    /// outcomes.
+    #[cfg(test)]
+    fn with_schedule(self, schedule: Schedule) -> Geometry {
+        assert!(schedule == Schedule::Stream || self.order.len() <= MAX_GROUP_OBJECTS);
+        Geometry { schedule, ..self }
     }
 
     /// The plain union: every object, every time.
@@ -518,6 +752,14 @@ impl Geometry {
     /// outcome and object for each ray on every level and in any company.
     pub fn march(&self, level: SimdLevel, batch: &mut MarchBatch) {
         let level = level.or_widest();
+        if self.schedule == Schedule::Groups {
+            // The level is available: `or_widest` says so.
+            let _ = level.dispatch(GroupMarch {
+                geometry: self,
+                batch,
+            });
+            return;
+        }
         // The level is available: `or_widest` says so.
         let _ = level.dispatch(Clip {
             geometry: self,
@@ -654,12 +896,47 @@ pub(crate) mod tests {
                 material: 0,
             })
             .collect();
-        for objects in [crowd(), lattice] {
-            check_streams(&Geometry::new(&objects));
+        for objects in [crowd(), lattice, room()] {
+            let geometry = Geometry::new(&objects);
+            let alone = check_streams(&geometry);
+            let other = match geometry.schedule {
+                Schedule::Stream => Schedule::Groups,
+                Schedule::Groups => Schedule::Stream,
+            };
+            assert_eq!(
+                check_streams(&geometry.with_schedule(other)),
+                alone,
+                "{other:?}"
+            );
         }
     }
 
-    fn check_streams(geometry: &Geometry) {
+    /// A room of boxes with spheres and a plane in it, marched in groups by default.
+    #[test]
+    fn rooms_are_marched_in_groups_and_crowds_in_streams() {
+        assert_eq!(Geometry::new(&room()).schedule, Schedule::Groups);
+        assert_eq!(Geometry::new(&crowd()).schedule, Schedule::Stream);
+    }
+
+    /// Boxes, spheres and a plane, thin and far ones among them.
+    fn room() -> Vec<Object> {
+        let sdfs = vec![
+            Sdf::cuboid(Vec3::new(3.0, 0.05, 3.0)).translate(Vec3::new(0.0, -1.0, 0.0)),
+            Sdf::cuboid(Vec3::new(0.05, 3.0, 3.0)).translate(Vec3::new(-3.0, 0.0, 0.0)),
+            Sdf::cuboid(Vec3::new(3.0, 3.0, 1e-3)).translate(Vec3::new(0.0, 0.0, -3.0)),
+            Sdf::sphere(0.5).translate(Vec3::new(-0.5, 0.0, 0.0)),
+            Sdf::sphere(1e-3).translate(Vec3::new(0.3, 0.2, 0.1)),
+            Sdf::sphere(0.4).translate(Vec3::new(0.0, 0.0, -60.0)),
+            Sdf::plane(Vec3::X, -40.0),
+        ];
+        sdfs.into_iter()
+            .map(|sdf| Object { sdf, material: 0 })
+            .collect()
+    }
+
+    /// Each ray's outcome in a stream of 1, 7, 16 and 600 rays on every level is what it is
+    /// alone on the scalar level; those outcomes, as bits.
+    fn check_streams(geometry: &Geometry) -> Vec<(u8, u32, u32, Option<usize>)> {
         let (mut rays, mut params) = (Vec::new(), Vec::new());
         for (i, p) in points().take(600).enumerate() {
             let origin =
@@ -712,6 +989,7 @@ pub(crate) mod tests {
                 assert!(got == alone, "{level:?}, streams of {stream}");
             }
         }
+        alone
     }
 
     #[test]

@@ -79,9 +79,9 @@ pub use crate::primitives::Primitive;
 pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
 pub use crate::stream::{
-    LaneGroups, MAX_LANES, StreamField, fill_lane_groups, sphere_trace_relaxed_stream,
-    sphere_trace_relaxed_stream_at, sphere_trace_relaxed_stream_of, sphere_trace_stream,
-    sphere_trace_stream_at, write_lane,
+    GroupEnds, GroupField, GroupRays, LaneGroups, MAX_LANES, StreamField, fill_lane_groups,
+    sphere_trace_relaxed_group, sphere_trace_relaxed_stream, sphere_trace_relaxed_stream_at,
+    sphere_trace_relaxed_stream_of, sphere_trace_stream, sphere_trace_stream_at, write_lane,
 };
 pub use crate::trace::{
     HIT_ULPS, OVER_RELAXATION, TraceOutcome, TraceParams, position_rounding,
