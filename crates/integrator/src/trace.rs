@@ -5,9 +5,12 @@ use std::time::Instant;
 
 use glam::Vec3;
 
-use lueur_sdf_math::{DistanceField, Ray, SimdLevel, TraceOutcome, TraceParams, sphere_trace};
+use lueur_sdf_math::{
+    DistanceField, Lane, LaneKernel, LaneVec3, MAX_LANES, Ray, SimdLevel, TraceOutcome,
+    TraceParams, fill_lane_groups, sphere_trace,
+};
 
-use lueur_scene::Marching;
+use lueur_scene::{Light, Marching};
 
 use crate::PreparedScene;
 use crate::geometry::MarchBatch;
@@ -222,6 +225,70 @@ pub(crate) struct TraceScratch {
     batch: MarchBatch,
     /// Per path ray: its parameters as marched, and whether it was marched inside.
     marched: Vec<(TraceParams, bool)>,
+    /// Per path ray, the nearest light it meets before its far limit, from [`LightTests`]:
+    /// its `t` and its index, or a negative index for none.
+    light_hits: Vec<(f32, f32)>,
+    /// [`LightTests`]' rays as rows of lanes ([`LIGHT_ROWS`]).
+    light_rows: Vec<[[f32; MAX_LANES]; LIGHT_ROWS]>,
+}
+
+/// Rows of a group of rays in [`TraceScratch::light_rows`]: the point the ray leaves, its
+/// direction, its far limit.
+const LIGHT_ROWS: usize = 7;
+
+/// The kernel that finds the nearest light each path ray meets from the point it leaves,
+/// before its far limit: [`PreparedScene::intersect_lights`] for a vector of rays at once,
+/// the same answer in each lane (each light's test is written once over lanes, and the
+/// nearest is taken in the same order, the first of equals kept).
+struct LightTests<'a> {
+    lights: &'a [Light],
+    rays: &'a [PathRay],
+    rows: &'a mut Vec<[[f32; MAX_LANES]; LIGHT_ROWS]>,
+    hits: &'a mut Vec<(f32, f32)>,
+}
+
+impl LaneKernel for LightTests<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let lanes = L::LANES.min(MAX_LANES);
+        let records = self.rays.iter().map(|r| {
+            [
+                r.from.x,
+                r.from.y,
+                r.from.z,
+                r.ray.dir.x,
+                r.ray.dir.y,
+                r.ray.dir.z,
+                r.params.t_max,
+            ]
+        });
+        fill_lane_groups(records, lanes, self.rows);
+        let (mut ts, mut lights) = ([0f32; MAX_LANES], [0f32; MAX_LANES]);
+        for (v, rays) in self.rows.iter().zip(self.rays.chunks(lanes)) {
+            let row = |i: usize| -> L { L::load(&v[i][..lanes]) };
+            let from = LaneVec3::new(row(0), row(1), row(2));
+            let dir = LaneVec3::new(row(3), row(4), row(5));
+            let t_max = row(6);
+            let (mut best_t, mut best) = (L::splat(0.0), L::splat(-1.0));
+            let mut found = L::splat(0.0).gt(L::splat(0.0));
+            for (i, light) in self.lights.iter().enumerate() {
+                let (t, meets) = light.intersect_lanes(from, dir);
+                let nearer = L::and(
+                    L::and(meets, t_max.gt(t)),
+                    L::not(L::and(found, L::not(best_t.gt(t)))),
+                );
+                best_t = L::select(nearer, t, best_t);
+                best = L::select(nearer, L::splat(i as f32), best);
+                found = L::or(found, nearer);
+            }
+            best_t.store(&mut ts[..lanes]);
+            best.store(&mut lights[..lanes]);
+            self.hits
+                .extend((0..rays.len()).map(|lane| (ts[lane], lights[lane])));
+        }
+    }
 }
 
 impl PreparedScene {
@@ -304,13 +371,23 @@ impl PreparedScene {
         scratch.batch.clear();
         scratch.marched.clear();
         let has_objects = !self.scene().objects.is_empty();
+        let lights = &self.scene().lights;
+        scratch.light_hits.clear();
+        if !lights.is_empty() {
+            // The level is available: `or_widest` says so.
+            let _ = tracing.simd.or_widest().dispatch(LightTests {
+                lights,
+                rays,
+                rows: &mut scratch.light_rows,
+                hits: &mut scratch.light_hits,
+            });
+        }
         for (i, r) in rays.iter().enumerate() {
             let params = r.params.resolving(r.ray.origin);
-            let light_ray = Ray {
-                origin: r.from,
-                dir: r.ray.dir,
+            let light_hit = match scratch.light_hits.get(i) {
+                Some(&(t, light)) if light >= 0.0 => Some((t, light as usize)),
+                _ => None,
             };
-            let light_hit = self.intersect_lights(light_ray, params.t_max, None);
             hits.push(light_hit.map(|(t, light)| Hit::Light { t, light }));
             let p = TraceParams {
                 t_max: light_hit.map_or(params.t_max, |(t, _)| t),

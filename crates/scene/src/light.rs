@@ -8,7 +8,7 @@ use lueur_sampling::{
     DirectionSample, RectangleFrame, quad_area_pdf, quad_solid_angle_pdf, sample_quad_area,
     sample_quad_solid_angle, sample_sphere_light, sphere_light_pdf,
 };
-use lueur_sdf_math::Ray;
+use lueur_sdf_math::{Lane, LaneVec3, Ray};
 
 /// A light source. Sphere and quad lights are also visible geometry (they
 /// are intersected analytically, which is exact and cheaper than marching a
@@ -138,6 +138,25 @@ impl Light {
                 ..
             } => ray_quad(ray, corner, edge_u, edge_v),
             Light::Directional { .. } => None,
+        }
+    }
+
+    /// [`Light::intersect`] for each lane's ray `origin + t dir`: its `t` and the lanes
+    /// that meet the light, bit for bit the scalar answer in each lane.
+    #[inline(always)]
+    pub fn intersect_lanes<L: Lane>(&self, origin: LaneVec3<L>, dir: LaneVec3<L>) -> (L, L::Mask) {
+        match *self {
+            Light::Sphere { center, radius, .. } => ray_sphere_lanes(origin, dir, center, radius),
+            Light::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                ..
+            } => ray_quad_lanes(origin, dir, corner, edge_u, edge_v),
+            Light::Directional { .. } => {
+                let zero = L::splat(0.0);
+                (zero, zero.gt(zero))
+            }
         }
     }
 
@@ -316,51 +335,86 @@ fn is_rectangle(edge_u: Vec3, edge_v: Vec3) -> bool {
     edge_u.dot(edge_v).abs() <= 1e-4 * edge_u.length() * edge_v.length()
 }
 
-/// Nearest positive intersection of a ray with a sphere (from outside or
-/// inside). Uses the numerically stable form of pbrt-v4 (section 6.8.1):
-/// the discriminant from `|o - c - (b) d|` avoids cancellation far away.
+/// Where a ray first meets the sphere (`t > 0`), if it does: [`ray_sphere_lanes`]'s
+/// one-lane instance.
 #[inline]
 pub(crate) fn ray_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<f32> {
-    let oc = ray.origin - center;
-    let b = oc.dot(ray.dir);
-    let perp = oc - b * ray.dir;
-    let disc = radius * radius - perp.length_squared();
+    let (t, hit) = ray_sphere_lanes::<f32>(ray.origin.into(), ray.dir.into(), center, radius);
+    hit.then_some(t)
+}
+
+/// Where each lane's ray `origin + t dir` first meets the sphere (`t > 0`, from outside
+/// or inside), and the lanes that meet it; written once over lanes, so that a vector of
+/// rays gets the scalar test's bits. The numerically stable form of pbrt-v4 (section
+/// 6.8.1): the discriminant from `|o - c - (b) d|` avoids cancellation far away.
+#[inline(always)]
+pub(crate) fn ray_sphere_lanes<L: Lane>(
+    origin: LaneVec3<L>,
+    dir: LaneVec3<L>,
+    center: Vec3,
+    radius: f32,
+) -> (L, L::Mask) {
+    let zero = L::splat(0.0);
+    let oc = origin - LaneVec3::splat(center);
+    let b = oc.dot(dir);
+    let perp = oc - dir * b;
+    let disc = L::splat(radius * radius) - perp.length_squared();
     // Computed whether or not the ray meets the sphere, and tested once at the end:
     // a branch on the discriminant is mispredicted for every ray that sees the light
     // among many that do not, and costs more than the arithmetic it would skip.
-    let root = disc.max(0.0).sqrt();
-    let q = -b + if b > 0.0 { -root } else { root };
-    let other = if q != 0.0 {
-        (oc.length_squared() - radius * radius) / q
-    } else {
-        q
-    };
-    let near = if q > other { other } else { q };
-    let far = if q > other { q } else { other };
-    let t = if near > 0.0 { near } else { far };
-    (!(disc < 0.0) & (t > 0.0)).then_some(t)
+    let root = disc.max(zero).sqrt();
+    let q = -b + L::select(b.gt(zero), -root, root);
+    let q_zero = L::and(q.ge(zero), zero.ge(q));
+    let other = L::select(
+        q_zero,
+        q,
+        (oc.length_squared() - L::splat(radius * radius)) / q,
+    );
+    let (near, far) = (
+        L::select(q.gt(other), other, q),
+        L::select(q.gt(other), q, other),
+    );
+    let t = L::select(near.gt(zero), near, far);
+    (t, L::and(L::not(disc.lt(zero)), t.gt(zero)))
 }
 
-/// Intersection of a ray with the parallelogram `corner + s eu + t ev`.
+/// Intersection of a ray with the parallelogram `corner + s eu + t ev`:
+/// [`ray_quad_lanes`]'s one-lane instance.
 #[inline]
 pub(crate) fn ray_quad(ray: &Ray, corner: Vec3, edge_u: Vec3, edge_v: Vec3) -> Option<f32> {
+    let (t, hit) = ray_quad_lanes::<f32>(ray.origin.into(), ray.dir.into(), corner, edge_u, edge_v);
+    hit.then_some(t)
+}
+
+/// Where each lane's ray meets the parallelogram `corner + s eu + t ev` (`t > 0`), and
+/// the lanes that meet it; written once over lanes, as [`ray_sphere_lanes`].
+#[inline(always)]
+pub(crate) fn ray_quad_lanes<L: Lane>(
+    origin: LaneVec3<L>,
+    dir: LaneVec3<L>,
+    corner: Vec3,
+    edge_u: Vec3,
+    edge_v: Vec3,
+) -> (L, L::Mask) {
+    let zero = L::splat(0.0);
     let n = edge_u.cross(edge_v);
-    let denom = n.dot(ray.dir);
+    let lanes_n = LaneVec3::splat(n);
+    let denom = lanes_n.dot(dir);
     // Not finite where the ray runs parallel to the plane (`denom` is 0).
-    let t = n.dot(corner - ray.origin) / denom;
-    let q = ray.at(t) - corner;
+    let t = lanes_n.dot(LaneVec3::splat(corner) - origin) / denom;
+    let q = origin + dir * t - LaneVec3::splat(corner);
     // Coordinates in the (edge_u, edge_v) basis by Cramer's rule with the
     // plane normal (works for any parallelogram), each times |n|^2: compared
     // with [0, |n|^2] rather than divided by it, which would put two
     // divisions on the chain every path ray waits on.
-    let nn = n.length_squared();
-    let s = n.dot(q.cross(edge_v));
-    let r = n.dot(edge_u.cross(q));
-    // One branch, on the whole test: one on the sign of `t` alone would be a coin toss
+    let nn = L::splat(n.length_squared());
+    let s = lanes_n.dot(q.cross(LaneVec3::splat(edge_v)));
+    let r = lanes_n.dot(LaneVec3::splat(edge_u).cross(q));
+    // One test, on the whole: a branch on the sign of `t` alone would be a coin toss
     // for rays leaving a surface, and its mispredictions cost more than the arithmetic
     // it would skip.
-    let hit = (t > 0.0) & t.is_finite() & (s >= 0.0) & (s <= nn) & (r >= 0.0) & (r <= nn);
-    hit.then_some(t)
+    let within = L::and(L::and(s.ge(zero), nn.ge(s)), L::and(r.ge(zero), nn.ge(r)));
+    (t, L::and(L::and(t.gt(zero), t.finite()), within))
 }
 
 #[cfg(test)]
@@ -377,6 +431,116 @@ mod tests {
         assert!(ray_sphere(&away, Vec3::ZERO, 1.0).is_none());
         let far = Ray::new(Vec3::new(0.0, 0.0, -1e4), Vec3::Z);
         assert!((ray_sphere(&far, Vec3::ZERO, 1.0).unwrap() - (1e4 - 1.0)).abs() < 1e-2);
+    }
+
+    /// Every light's test over a vector of rays, on every level, gives each lane what the
+    /// scalar test gives its ray, bit for bit: rays from near and far (1e4 away), toward,
+    /// along and away from each light, from inside the sphere, parallel to the quad.
+    #[test]
+    fn a_vector_of_rays_meets_each_light_as_each_ray_alone() {
+        use lueur_sdf_math::{LaneKernel, MAX_LANES, SimdLevel};
+
+        struct Tests<'a> {
+            light: &'a Light,
+            rays: &'a [Ray],
+        }
+
+        impl LaneKernel for Tests<'_> {
+            type Output = Vec<Option<u32>>;
+
+            fn run<L: Lane>(self) -> Vec<Option<u32>> {
+                let lanes = L::LANES.min(MAX_LANES);
+                let mut out = Vec::new();
+                for rays in self.rays.chunks(lanes) {
+                    let mut rows = [[0f32; MAX_LANES]; 6];
+                    for (lane, r) in rays.iter().enumerate() {
+                        let values = [
+                            r.origin.x, r.origin.y, r.origin.z, r.dir.x, r.dir.y, r.dir.z,
+                        ];
+                        for (row, v) in rows.iter_mut().zip(values) {
+                            row[lane] = v;
+                        }
+                    }
+                    let row = |i: usize| L::load(&rows[i][..lanes]);
+                    let origin = LaneVec3::new(row(0), row(1), row(2));
+                    let dir = LaneVec3::new(row(3), row(4), row(5));
+                    let (t, meets) = self.light.intersect_lanes(origin, dir);
+                    let mut ts = [0f32; MAX_LANES];
+                    t.store(&mut ts[..lanes]);
+                    let meets = L::bits(meets);
+                    out.extend(
+                        (0..rays.len())
+                            .map(|lane| (meets >> lane & 1 == 1).then(|| ts[lane].to_bits())),
+                    );
+                }
+                out
+            }
+        }
+
+        let lights = [
+            Light::Sphere {
+                center: Vec3::new(0.3, 2.0, -0.4),
+                radius: 0.25,
+                radiance: Vec3::ONE,
+            },
+            Light::Sphere {
+                center: Vec3::new(1e4, 0.0, 0.0),
+                radius: 0.3,
+                radiance: Vec3::ONE,
+            },
+            Light::Quad {
+                corner: Vec3::new(-0.5, 1.9, -0.5),
+                edge_u: Vec3::new(1.0, 0.0, 0.0),
+                edge_v: Vec3::new(0.0, 0.1, 1.0),
+                radiance: Vec3::ONE,
+            },
+            Light::Directional {
+                direction: -Vec3::Y,
+                irradiance: Vec3::ONE,
+            },
+        ];
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+        };
+        for light in &lights {
+            let mut rays = Vec::new();
+            for i in 0..300 {
+                let origin = match i % 4 {
+                    0 => Vec3::new(uniform(), uniform(), uniform()) * 4.0,
+                    1 => Vec3::new(-1e4, uniform(), uniform()),
+                    2 => {
+                        Vec3::new(0.3, 2.0, -0.4) + Vec3::new(uniform(), uniform(), uniform()) * 0.1
+                    }
+                    _ => Vec3::new(uniform(), 1.9, uniform()),
+                };
+                let target = match i % 3 {
+                    0 => Vec3::new(0.3, 2.0, -0.4),
+                    1 => Vec3::new(1e4, 0.0, 0.0),
+                    _ => Vec3::new(0.0, 1.95, 0.0),
+                } + Vec3::new(uniform(), uniform(), uniform()) * 0.6;
+                let dir = match i % 7 {
+                    0 => Vec3::new(1.0, 0.0, uniform()),
+                    1 => origin - target,
+                    _ => target - origin,
+                };
+                rays.push(Ray::new(origin, dir));
+            }
+            let alone: Vec<_> = rays
+                .iter()
+                .map(|r| light.intersect(r).map(f32::to_bits))
+                .collect();
+            if !matches!(light, Light::Directional { .. }) {
+                assert!(alone.iter().any(Option::is_some) && alone.iter().any(Option::is_none));
+            }
+            for level in SimdLevel::available() {
+                let got = level.dispatch(Tests { light, rays: &rays }).unwrap();
+                assert_eq!(got, alone, "{light:?}, {level:?}");
+            }
+        }
     }
 
     #[test]
