@@ -1,7 +1,8 @@
 //! Points per second of the lane paths: a few representative fields, prepared as the
 //! tracer prepares objects, evaluated at 4096 points on every path this CPU has, so that
 //! each path reads as a ratio to `Scalar` in one run; and rays per second of the stream
-//! tracer on the same fields, against `sphere_trace` one ray at a time.
+//! tracer on the same fields, against `sphere_trace` one ray at a time, and of the relaxed
+//! march in groups (a vector of rays marched to its last ray's end, no refill).
 //!
 //! `cargo bench -p lueur-sdf-math --bench lanes`; the first line says which CPU features
 //! the run had.
@@ -11,8 +12,8 @@ use std::hint::black_box;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use lueur_sdf_math::{
     LaneDistance, OVER_RELAXATION, PreparedSdf, Quat, Ray, Sdf, SimdLevel, TraceOutcome,
-    TraceParams, Vec3, sphere_trace, sphere_trace_relaxed, sphere_trace_relaxed_stream_at,
-    sphere_trace_stream_at,
+    TraceParams, Vec3, sphere_trace, sphere_trace_relaxed, sphere_trace_relaxed_groups_at,
+    sphere_trace_relaxed_stream_at, sphere_trace_stream_at,
 };
 
 const POINTS: usize = 4096;
@@ -155,6 +156,24 @@ fn stream(c: &mut Criterion) {
                 b.iter(|| {
                     let rays = black_box(&rays);
                     sphere_trace_relaxed_stream_at(
+                        level,
+                        &field,
+                        rays,
+                        &params,
+                        OVER_RELAXATION,
+                        &mut out,
+                    )
+                    .unwrap();
+                    black_box(&out);
+                })
+            });
+        }
+        for level in SimdLevel::available() {
+            let id = format!("relaxed groups {level:?}");
+            group.bench_function(BenchmarkId::from_parameter(id), |b| {
+                b.iter(|| {
+                    let rays = black_box(&rays);
+                    sphere_trace_relaxed_groups_at(
                         level,
                         &field,
                         rays,

@@ -80,8 +80,9 @@ pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
 pub use crate::stream::{
     GroupEnds, GroupField, GroupRays, LaneGroups, MAX_LANES, StreamField, fill_lane_groups,
-    sphere_trace_relaxed_group, sphere_trace_relaxed_stream, sphere_trace_relaxed_stream_at,
-    sphere_trace_relaxed_stream_of, sphere_trace_stream, sphere_trace_stream_at, write_lane,
+    sphere_trace_relaxed_group, sphere_trace_relaxed_groups_at, sphere_trace_relaxed_stream,
+    sphere_trace_relaxed_stream_at, sphere_trace_relaxed_stream_of, sphere_trace_stream,
+    sphere_trace_stream_at, write_lane,
 };
 pub use crate::trace::{
     HIT_ULPS, OVER_RELAXATION, TraceOutcome, TraceParams, position_rounding,

@@ -399,6 +399,105 @@ pub fn sphere_trace_relaxed_stream_of<F: StreamField>(
     }
 }
 
+/// [`sphere_trace_relaxed_stream_at`] with the rays marched in groups of a vector each
+/// ([`sphere_trace_relaxed_group`]) rather than as a stream: the same outcome for every ray,
+/// bit for bit, on every path. The plain march where `omega_max` is not above 1, as a
+/// stream.
+///
+/// # Panics
+/// If `rays`, `params` and `out` differ in length.
+pub fn sphere_trace_relaxed_groups_at<F>(
+    level: SimdLevel,
+    field: &F,
+    rays: &[Ray],
+    params: &[TraceParams],
+    omega_max: f32,
+    out: &mut [TraceOutcome],
+) -> Result<(), UnavailableLevel>
+where
+    F: LaneDistance + DistanceField + ?Sized,
+{
+    if !(omega_max > 1.0 && omega_max.is_finite()) {
+        return sphere_trace_relaxed_stream_at(level, field, rays, params, omega_max, out);
+    }
+    assert!(
+        rays.len() == params.len() && rays.len() == out.len(),
+        "sphere_trace_relaxed_groups: {} rays, {} parameters, {} outcomes",
+        rays.len(),
+        params.len(),
+        out.len()
+    );
+    level.dispatch(RelaxedGroups {
+        field,
+        rays,
+        params,
+        omega_max,
+        out,
+    })
+}
+
+/// The kernel of [`sphere_trace_relaxed_groups_at`]: each vector of rays loaded from rows
+/// and marched to its last ray's end.
+struct RelaxedGroups<'a, F: ?Sized> {
+    field: &'a F,
+    rays: &'a [Ray],
+    params: &'a [TraceParams],
+    omega_max: f32,
+    out: &'a mut [TraceOutcome],
+}
+
+impl<F: LaneDistance + DistanceField + ?Sized, L: Lane> GroupField<L> for Shared<'_, F> {
+    #[inline(always)]
+    fn distance_lanes(&mut self, p: LaneVec3<L>, _: L::Mask) -> L {
+        self.0.distance_lanes(p)
+    }
+}
+
+impl<F: LaneDistance + DistanceField + ?Sized> LaneKernel for RelaxedGroups<'_, F> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let lanes = L::LANES.min(MAX_LANES);
+        let records = self.rays.iter().zip(self.params).map(|(r, p)| {
+            [
+                r.origin.x,
+                r.origin.y,
+                r.origin.z,
+                r.dir.x,
+                r.dir.y,
+                r.dir.z,
+                p.t_min,
+                p.t_max,
+                p.max_steps as f32,
+                p.eps_abs,
+                p.eps_rel,
+            ]
+        });
+        let mut rows = Vec::new();
+        fill_lane_groups(records, lanes, &mut rows);
+        let index: [f32; MAX_LANES] = std::array::from_fn(|i| i as f32);
+        let lipschitz = self.field.lipschitz();
+        let mut ends = [TraceOutcome::Miss { steps: 0 }; MAX_LANES];
+        for (v, out) in rows.iter().zip(self.out.chunks_mut(lanes)) {
+            let row = |i: usize| L::load(&v[i][..lanes]);
+            let group = GroupRays {
+                origin: LaneVec3::new(row(0), row(1), row(2)),
+                dir: LaneVec3::new(row(3), row(4), row(5)),
+                t_min: row(6),
+                t_max: row(7),
+                max_steps: row(8),
+                eps_abs: row(9),
+                eps_rel: row(10),
+                live: L::load(&index[..lanes]).lt(L::splat(out.len() as f32)),
+            };
+            sphere_trace_relaxed_group(&mut Shared(self.field), lipschitz, &group, self.omega_max)
+                .store(&mut ends);
+            out.copy_from_slice(&ends[..out.len()]);
+        }
+    }
+}
+
 /// The kernel of the plain streams: the field per vector, each lane's march
 /// ([`HartMarch`]) per lane.
 struct PlainStream<'a, F> {
@@ -795,84 +894,9 @@ mod tests {
         }
     }
 
-    /// A whole field for a group: every lane's ray marches the same one.
-    struct Whole<'a, F>(&'a F);
-
-    impl<F: LaneDistance, L: Lane> GroupField<L> for Whole<'_, F> {
-        #[inline(always)]
-        fn distance_lanes(&mut self, p: LaneVec3<L>, _: L::Mask) -> L {
-            self.0.distance_lanes(p)
-        }
-    }
-
-    /// Marches `rays` in groups of a vector each, the last one short, with the lanes past
-    /// its rays outside `live`, which must come back as misses in no step.
-    struct Groups<'a, F> {
-        field: &'a F,
-        rays: &'a [Ray],
-        params: &'a [TraceParams],
-        omega_max: f32,
-    }
-
-    impl<F: LaneDistance + DistanceField> LaneKernel for Groups<'_, F> {
-        type Output = Vec<TraceOutcome>;
-
-        fn run<L: Lane>(self) -> Vec<TraceOutcome> {
-            let lanes = L::LANES.min(MAX_LANES);
-            let mut out = Vec::new();
-            for (rays, params) in self.rays.chunks(lanes).zip(self.params.chunks(lanes)) {
-                let mut rows = [[0f32; MAX_LANES]; 11];
-                for (lane, (r, p)) in rays.iter().zip(params).enumerate() {
-                    let values = [
-                        r.origin.x,
-                        r.origin.y,
-                        r.origin.z,
-                        r.dir.x,
-                        r.dir.y,
-                        r.dir.z,
-                        p.t_min,
-                        p.t_max,
-                        p.max_steps as f32,
-                        p.eps_abs,
-                        p.eps_rel,
-                    ];
-                    write_lane(&mut rows, lane, values);
-                }
-                let row = |i: usize| L::load(&rows[i][..lanes]);
-                let index: [f32; MAX_LANES] = std::array::from_fn(|i| i as f32);
-                let group = GroupRays {
-                    origin: LaneVec3::new(row(0), row(1), row(2)),
-                    dir: LaneVec3::new(row(3), row(4), row(5)),
-                    t_min: row(6),
-                    t_max: row(7),
-                    max_steps: row(8),
-                    eps_abs: row(9),
-                    eps_rel: row(10),
-                    live: L::load(&index[..lanes]).lt(L::splat(rays.len() as f32)),
-                };
-                let ends = sphere_trace_relaxed_group(
-                    &mut Whole(self.field),
-                    self.field.lipschitz(),
-                    &group,
-                    self.omega_max,
-                );
-                let mut got = [TraceOutcome::GaveUp { t: 0.0, steps: 9 }; MAX_LANES];
-                ends.store(&mut got);
-                assert!(
-                    got[rays.len()..lanes]
-                        .iter()
-                        .all(|o| *o == TraceOutcome::Miss { steps: 0 }),
-                    "a lane without a ray"
-                );
-                out.extend_from_slice(&got[..rays.len()]);
-            }
-            out
-        }
-    }
-
     /// Groups against the scalar relaxed tracer, on every level.
     fn check_group<F: LaneDistance + DistanceField>(name: &str, field: &F) {
-        for omega_max in [2.0, OVER_RELAXATION] {
+        for omega_max in [1.0, 2.0, OVER_RELAXATION] {
             for n in [1, 7, 16, 100] {
                 let (rays, params) = rays(n);
                 let expected: Vec<_> = rays
@@ -881,13 +905,12 @@ mod tests {
                     .map(|(r, p)| bits(&sphere_trace_relaxed(field, r, p, omega_max)))
                     .collect();
                 for level in SimdLevel::available() {
-                    let kernel = Groups {
-                        field,
-                        rays: &rays,
-                        params: &params,
-                        omega_max,
-                    };
-                    let got: Vec<_> = level.dispatch(kernel).unwrap().iter().map(bits).collect();
+                    let mut out = vec![TraceOutcome::GaveUp { t: 0.0, steps: 9 }; n];
+                    sphere_trace_relaxed_groups_at(
+                        level, field, &rays, &params, omega_max, &mut out,
+                    )
+                    .unwrap();
+                    let got: Vec<_> = out.iter().map(bits).collect();
                     assert_eq!(
                         got, expected,
                         "{name}, omega {omega_max}, {n} rays, {level:?}"
