@@ -916,6 +916,23 @@ pub(crate) mod tests {
     fn rooms_are_marched_in_groups_and_crowds_in_streams() {
         assert_eq!(Geometry::new(&room()).schedule, Schedule::Groups);
         assert_eq!(Geometry::new(&crowd()).schedule, Schedule::Stream);
+        // A lane mask per object: past that many, the stream.
+        let spheres = |n: usize| -> Vec<Object> {
+            (0..n)
+                .map(|i| Object {
+                    sdf: Sdf::sphere(0.1).translate(Vec3::X * i as f32),
+                    material: 0,
+                })
+                .collect()
+        };
+        assert_eq!(
+            Geometry::new(&spheres(MAX_GROUP_OBJECTS)).schedule,
+            Schedule::Groups
+        );
+        assert_eq!(
+            Geometry::new(&spheres(MAX_GROUP_OBJECTS + 1)).schedule,
+            Schedule::Stream
+        );
     }
 
     /// Boxes, spheres and a plane, thin and far ones among them.
