@@ -12,8 +12,8 @@ use std::hint::black_box;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use lueur_sdf_math::{
     LaneDistance, OVER_RELAXATION, PreparedSdf, Quat, Ray, Sdf, SimdLevel, TraceOutcome,
-    TraceParams, Vec3, sphere_trace, sphere_trace_relaxed, sphere_trace_relaxed_groups_at,
-    sphere_trace_relaxed_stream_at, sphere_trace_stream_at,
+    TraceParams, UnavailableLevel, Vec3, sphere_trace, sphere_trace_relaxed,
+    sphere_trace_relaxed_groups_at, sphere_trace_relaxed_stream_at, sphere_trace_stream_at,
 };
 
 const POINTS: usize = 4096;
@@ -150,41 +150,29 @@ fn stream(c: &mut Criterion) {
                 black_box(&out);
             })
         });
-        for level in SimdLevel::available() {
-            let id = format!("relaxed {level:?}");
-            group.bench_function(BenchmarkId::from_parameter(id), |b| {
-                b.iter(|| {
-                    let rays = black_box(&rays);
-                    sphere_trace_relaxed_stream_at(
-                        level,
-                        &field,
-                        rays,
-                        &params,
-                        OVER_RELAXATION,
-                        &mut out,
-                    )
-                    .unwrap();
-                    black_box(&out);
-                })
-            });
-        }
-        for level in SimdLevel::available() {
-            let id = format!("relaxed groups {level:?}");
-            group.bench_function(BenchmarkId::from_parameter(id), |b| {
-                b.iter(|| {
-                    let rays = black_box(&rays);
-                    sphere_trace_relaxed_groups_at(
-                        level,
-                        &field,
-                        rays,
-                        &params,
-                        OVER_RELAXATION,
-                        &mut out,
-                    )
-                    .unwrap();
-                    black_box(&out);
-                })
-            });
+        type March = fn(
+            SimdLevel,
+            &PreparedSdf,
+            &[Ray],
+            &[TraceParams],
+            f32,
+            &mut [TraceOutcome],
+        ) -> Result<(), UnavailableLevel>;
+        let marches: [(&str, March); 2] = [
+            ("relaxed", sphere_trace_relaxed_stream_at),
+            ("relaxed groups", sphere_trace_relaxed_groups_at),
+        ];
+        for (kind, march) in marches {
+            for level in SimdLevel::available() {
+                let id = format!("{kind} {level:?}");
+                group.bench_function(BenchmarkId::from_parameter(id), |b| {
+                    b.iter(|| {
+                        let rays = black_box(&rays);
+                        march(level, &field, rays, &params, OVER_RELAXATION, &mut out).unwrap();
+                        black_box(&out);
+                    })
+                });
+            }
         }
         group.finish();
     }

@@ -858,7 +858,8 @@ mod tests {
         ]
     }
 
-    /// Both streams against their scalar tracers; `omega_max` 1 is the plain march.
+    /// Both streams and the groups against their scalar tracers; `omega_max` 1 is the plain
+    /// march.
     fn check<F: LaneDistance + DistanceField>(name: &str, field: &F) {
         for omega_max in [1.0, 2.0, OVER_RELAXATION] {
             for n in [1, 7, 16, 100] {
@@ -879,6 +880,16 @@ mod tests {
                         got, expected,
                         "{name}, omega {omega_max}, {n} rays, {level:?}"
                     );
+                    out.fill(TraceOutcome::GaveUp { t: 0.0, steps: 9 });
+                    sphere_trace_relaxed_groups_at(
+                        level, field, &rays, &params, omega_max, &mut out,
+                    )
+                    .unwrap();
+                    let groups: Vec<_> = out.iter().map(bits).collect();
+                    assert_eq!(
+                        groups, expected,
+                        "{name}, groups, omega {omega_max}, {n} rays, {level:?}"
+                    );
                     if omega_max == 1.0 {
                         sphere_trace_stream_at(level, field, &rays, &params, &mut out).unwrap();
                         let plain: Vec<_> = out.iter().map(bits).collect();
@@ -894,45 +905,8 @@ mod tests {
         }
     }
 
-    /// Groups against the scalar relaxed tracer, on every level.
-    fn check_group<F: LaneDistance + DistanceField>(name: &str, field: &F) {
-        for omega_max in [1.0, 2.0, OVER_RELAXATION] {
-            for n in [1, 7, 16, 100] {
-                let (rays, params) = rays(n);
-                let expected: Vec<_> = rays
-                    .iter()
-                    .zip(&params)
-                    .map(|(r, p)| bits(&sphere_trace_relaxed(field, r, p, omega_max)))
-                    .collect();
-                for level in SimdLevel::available() {
-                    let mut out = vec![TraceOutcome::GaveUp { t: 0.0, steps: 9 }; n];
-                    sphere_trace_relaxed_groups_at(
-                        level, field, &rays, &params, omega_max, &mut out,
-                    )
-                    .unwrap();
-                    let got: Vec<_> = out.iter().map(bits).collect();
-                    assert_eq!(
-                        got, expected,
-                        "{name}, omega {omega_max}, {n} rays, {level:?}"
-                    );
-                }
-            }
-        }
-    }
-
     #[test]
-    fn every_ray_of_a_group_takes_the_scalar_relaxed_steps() {
-        for (name, sdf) in fields() {
-            check_group(name, &sdf);
-            check_group(
-                name,
-                &PreparedSdf::new(&sdf.clone().translate(Vec3::Y * 0.25)),
-            );
-        }
-    }
-
-    #[test]
-    fn every_ray_of_a_stream_takes_the_scalar_tracers_steps_plain_or_relaxed() {
+    fn every_ray_of_a_stream_or_group_takes_the_scalar_tracers_steps() {
         for (name, sdf) in fields() {
             check(name, &sdf);
             check(
