@@ -1,6 +1,6 @@
 //! The scene as the integrator sees it: the scene model with what tracing
 //! and light sampling derive from it once. The queries live beside it:
-//! acceleration in `geometry.rs`, tracing in `trace.rs` and the choice
+//! acceleration in `geometry/`, tracing in `trace.rs` and the choice
 //! among the lights in `light_sampler.rs`.
 
 use glam::Vec3;

@@ -50,6 +50,7 @@
 mod blend;
 mod bound;
 mod field;
+mod group;
 mod lanes;
 mod normal;
 mod prepared;
@@ -66,6 +67,9 @@ pub use glam::{Quat, Vec3};
 pub use crate::blend::{smooth_max, smooth_min};
 pub use crate::bound::{Aabb, BoundingSphere, HalfSpace, RayClip, RayClipLanes};
 pub use crate::field::DistanceField;
+pub use crate::group::{
+    GroupEnds, GroupField, GroupRays, sphere_trace_relaxed_group, sphere_trace_relaxed_groups_at,
+};
 pub use crate::lanes::{
     Avx2, Avx512, BitMask, Isa, Lane, LaneDistance, LaneKernel, LaneMask, LaneVec3, Mask, MaskLane,
     Neon, Portable, SimdLevel, Sse, Task, UnavailableLevel, Wide,
@@ -79,8 +83,7 @@ pub use crate::primitives::Primitive;
 pub use crate::ray::Ray;
 pub use crate::sdf::Sdf;
 pub use crate::stream::{
-    GroupEnds, GroupField, GroupRays, LaneGroups, MAX_LANES, StreamField, fill_lane_groups,
-    sphere_trace_relaxed_group, sphere_trace_relaxed_groups_at, sphere_trace_relaxed_stream,
+    LaneGroups, MAX_LANES, StreamField, fill_lane_groups, sphere_trace_relaxed_stream,
     sphere_trace_relaxed_stream_at, sphere_trace_relaxed_stream_of, sphere_trace_stream,
     sphere_trace_stream_at, write_lane,
 };
