@@ -4,7 +4,7 @@
 
 use lueur_sdf_math::{
     GroupField, GroupRays, Lane, LaneKernel, LaneVec3, MAX_LANES, OVER_RELAXATION, RayClipLanes,
-    TraceOutcome, fill_lane_groups, sphere_trace_relaxed_group,
+    TraceOutcome, sphere_trace_relaxed_group,
 };
 
 #[cfg(doc)]
@@ -25,23 +25,7 @@ impl LaneKernel for GroupMarch<'_> {
     fn run<L: Lane>(self) {
         let GroupMarch { geometry, batch } = self;
         let lanes = L::LANES.min(MAX_LANES);
-        let mut rows = std::mem::take(&mut batch.group_rows);
-        let records = batch.queued.iter().map(|(_, ray, p)| {
-            [
-                ray.origin.x,
-                ray.origin.y,
-                ray.origin.z,
-                ray.dir.x,
-                ray.dir.y,
-                ray.dir.z,
-                p.eps_abs,
-                p.eps_rel,
-                p.t_min,
-                p.t_max,
-                p.max_steps as f32,
-            ]
-        });
-        fill_lane_groups(records, lanes, &mut rows);
+        let rows = batch.fill_rows(lanes);
         let index: [f32; MAX_LANES] = std::array::from_fn(|i| i as f32);
         let mut outcomes = [TraceOutcome::Miss { steps: 0 }; MAX_LANES];
         let mut nearest = [0f32; MAX_LANES];
@@ -100,7 +84,7 @@ impl LaneKernel for GroupMarch<'_> {
                 }
             }
         }
-        batch.group_rows = rows;
+        batch.rows = rows;
     }
 }
 

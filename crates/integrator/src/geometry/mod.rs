@@ -7,7 +7,7 @@ use glam::Vec3;
 use lueur_sdf_math::{
     Aabb, BoundingSphere, DistanceField, HalfSpace, Lane, LaneDistance, LaneVec3, MAX_LANES,
     OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClipLanes, Sdf, SimdLevel, TraceOutcome,
-    TraceParams, sphere_trace, sphere_trace_relaxed_stream_of,
+    TraceParams, fill_lane_groups, sphere_trace, sphere_trace_relaxed_stream_of,
 };
 
 use lueur_scene::{Marching, Object};
@@ -148,14 +148,11 @@ pub(crate) struct MarchBatch {
     /// candidates of each lane among them: position `j` of the group as `2^j`, summed.
     kept: Vec<[f32; MAX_LANES]>,
     /// While clipping, per group of queued rays a vector holds, their rays and parameters
-    /// as rows of lanes ([`CLIP_ROWS`]).
-    clip_rows: Vec<[[f32; MAX_LANES]; CLIP_ROWS]>,
+    /// as rows of lanes ([`MarchBatch::fill_rows`]).
+    rows: Vec<[[f32; MAX_LANES]; RAY_ROWS]>,
     /// While marching, [`CandidateLanes`]'s `member` and `members`.
     member: Vec<[f32; MAX_LANES]>,
     members: Vec<u32>,
-    /// In [`Schedule::Groups`], per group of queued rays a vector holds, their rays and
-    /// parameters as rows of lanes ([`GROUP_ROWS`]).
-    group_rows: Vec<[[f32; MAX_LANES]; GROUP_ROWS]>,
 }
 
 impl MarchBatch {
@@ -177,6 +174,30 @@ impl MarchBatch {
         self.queued.push((tag, ray, params));
     }
 
+    /// Takes the buffer of rows and fills it with the queued rays, `lanes` to a group
+    /// ([`fill_lane_groups`], which says why every group is written before a kernel loads
+    /// the first); the kernel hands the buffer back to [`MarchBatch::rows`].
+    fn fill_rows(&mut self, lanes: usize) -> Vec<[[f32; MAX_LANES]; RAY_ROWS]> {
+        let mut rows = std::mem::take(&mut self.rows);
+        let records = self.queued.iter().map(|(_, ray, p)| {
+            [
+                ray.origin.x,
+                ray.origin.y,
+                ray.origin.z,
+                ray.dir.x,
+                ray.dir.y,
+                ray.dir.z,
+                p.eps_abs,
+                p.eps_rel,
+                p.t_min,
+                p.t_max,
+                p.max_steps as f32,
+            ]
+        });
+        fill_lane_groups(records, lanes, &mut rows);
+        rows
+    }
+
     /// After [`Geometry::march`], each queued ray's tag, outcome and object hit (`None` on
     /// a miss), the rays that met no candidate first.
     pub fn results(&self) -> impl Iterator<Item = (usize, TraceOutcome, Option<usize>)> + '_ {
@@ -196,13 +217,10 @@ impl MarchBatch {
     }
 }
 
-/// Rows of a group of rays in [`MarchBatch::clip_rows`]: the origin, the direction, then
-/// the parameters `eps_abs`, `eps_rel`, `t_min`, `t_max`.
-const CLIP_ROWS: usize = 10;
-
-/// Rows of a group of rays in [`MarchBatch::group_rows`]: [`CLIP_ROWS`]'s, then the step
-/// cap.
-const GROUP_ROWS: usize = CLIP_ROWS + 1;
+/// Rows of a group of rays in [`MarchBatch::rows`]: the origin, the direction, then the
+/// parameters `eps_abs`, `eps_rel`, `t_min`, `t_max` and the step cap (which only
+/// [`Schedule::Groups`] reads).
+const RAY_ROWS: usize = 11;
 
 /// Objects per row of [`MarchBatch::kept`]: sums of distinct powers of two are exact in
 /// `f32` below `2^24`.

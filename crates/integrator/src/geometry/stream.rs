@@ -4,7 +4,7 @@
 
 use lueur_sdf_math::{
     Lane, LaneKernel, LaneVec3, MAX_LANES, Ray, RayClipLanes, StreamField, TraceOutcome,
-    TraceParams, fill_lane_groups,
+    TraceParams,
 };
 
 #[cfg(doc)]
@@ -30,24 +30,8 @@ impl LaneKernel for Clip<'_> {
             geometry.order.len().div_ceil(OBJECTS_PER_MASK),
             [0.0; MAX_LANES],
         );
-        // Every group's rows first, then each group's clip ([`fill_lane_groups`] says
-        // why). Lanes past a short last group are never read (`live`).
-        let mut rows = std::mem::take(&mut batch.clip_rows);
-        let records = batch.queued.iter().map(|(_, ray, p)| {
-            [
-                ray.origin.x,
-                ray.origin.y,
-                ray.origin.z,
-                ray.dir.x,
-                ray.dir.y,
-                ray.dir.z,
-                p.eps_abs,
-                p.eps_rel,
-                p.t_min,
-                p.t_max,
-            ]
-        });
-        fill_lane_groups(records, lanes, &mut rows);
+        // Lanes past a short last group are never read (`live`).
+        let rows = batch.fill_rows(lanes);
         let mut start = 0;
         for v in &rows {
             let group = start..(start + lanes).min(batch.queued.len());
@@ -108,7 +92,7 @@ impl LaneKernel for Clip<'_> {
             }
         }
         batch.kept = kept_rows;
-        batch.clip_rows = rows;
+        batch.rows = rows;
     }
 }
 
