@@ -25,15 +25,15 @@ impl LaneKernel for GroupMarch<'_> {
     fn run<L: Lane>(self) {
         let GroupMarch { geometry, batch } = self;
         let lanes = L::LANES.min(MAX_LANES);
-        let rows = batch.fill_rows(lanes);
+        let (queued, rows) = (
+            std::mem::take(&mut batch.queued),
+            std::mem::take(&mut batch.rows),
+        );
         let index: [f32; MAX_LANES] = std::array::from_fn(|i| i as f32);
         let mut outcomes = [TraceOutcome::Miss { steps: 0 }; MAX_LANES];
         let mut nearest = [0f32; MAX_LANES];
-        let mut start = 0;
-        for v in &rows {
-            let group = start..(start + lanes).min(batch.queued.len());
-            start = group.end;
-            let row = |i: usize| -> L { L::load(&v[i][..lanes]) };
+        for (group, v, lane0) in MarchBatch::vectors(queued.len(), &rows, lanes) {
+            let row = |i: usize| -> L { L::load(&v[i][lane0..lane0 + lanes]) };
             let (origin, dir) = (
                 LaneVec3::new(row(0), row(1), row(2)),
                 LaneVec3::new(row(3), row(4), row(5)),
@@ -74,7 +74,7 @@ impl LaneKernel for GroupMarch<'_> {
             ends.store(&mut outcomes);
             field.last.store(&mut nearest[..lanes]);
             let marched = L::bits(marched);
-            for (lane, &(tag, _, _)) in batch.queued[group].iter().enumerate() {
+            for (lane, &tag) in queued[group].iter().enumerate() {
                 if marched >> lane & 1 == 0 {
                     batch.misses.push(tag);
                 } else {
@@ -84,7 +84,7 @@ impl LaneKernel for GroupMarch<'_> {
                 }
             }
         }
-        batch.rows = rows;
+        (batch.queued, batch.rows) = (queued, rows);
     }
 }
 

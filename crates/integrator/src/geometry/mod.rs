@@ -3,11 +3,13 @@
 //! per-ray field of candidate objects, bounding-sphere culling) and the
 //! plain union every speed-up is checked against.
 
+use std::ops::Range;
+
 use glam::Vec3;
 use lueur_sdf_math::{
-    Aabb, BoundingSphere, DistanceField, HalfSpace, Lane, LaneDistance, LaneVec3, MAX_LANES,
-    OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClipLanes, Sdf, SimdLevel, TraceOutcome,
-    TraceParams, fill_lane_groups, sphere_trace, sphere_trace_relaxed_stream_of,
+    Aabb, BoundingSphere, DistanceField, HalfSpace, Lane, LaneDistance, LaneGroups, LaneVec3,
+    MAX_LANES, OVER_RELAXATION, PreparedSdf, Primitive, Ray, RayClipLanes, Sdf, SimdLevel,
+    TraceOutcome, TraceParams, sphere_trace, sphere_trace_relaxed_stream_of,
 };
 
 use lueur_scene::{Marching, Object};
@@ -127,8 +129,10 @@ impl ObjectBound {
 /// Buffers are kept from one stream to the next, so that a thread allocates them once.
 #[derive(Debug, Default)]
 pub(crate) struct MarchBatch {
-    /// The rays queued, with their parameters and the caller's tag for each.
-    queued: Vec<(usize, Ray, TraceParams)>,
+    /// The caller's tag for each ray queued.
+    queued: Vec<usize>,
+    /// The rays queued and their parameters, as rows of lanes ([`MarchBatch::queue`]).
+    rows: LaneGroups<RAY_ROWS>,
     /// The tags of the queued rays that meet no candidate: misses in zero steps.
     misses: Vec<usize>,
     /// Per marched ray: the ray, its parameters clipped to the range its candidates
@@ -147,9 +151,6 @@ pub(crate) struct MarchBatch {
     /// While clipping, per group of [`OBJECTS_PER_MASK`] positions in the order, the
     /// candidates of each lane among them: position `j` of the group as `2^j`, summed.
     kept: Vec<[f32; MAX_LANES]>,
-    /// While clipping, per group of queued rays a vector holds, their rays and parameters
-    /// as rows of lanes ([`MarchBatch::fill_rows`]).
-    rows: Vec<[[f32; MAX_LANES]; RAY_ROWS]>,
     /// While marching, [`CandidateLanes`]'s `member` and `members`.
     member: Vec<[f32; MAX_LANES]>,
     members: Vec<u32>,
@@ -159,6 +160,7 @@ impl MarchBatch {
     /// Empties the batch for a new stream.
     pub fn clear(&mut self) {
         self.queued.clear();
+        self.rows.clear();
         self.misses.clear();
         self.rays.clear();
         self.params.clear();
@@ -169,33 +171,42 @@ impl MarchBatch {
         self.nearest.clear();
     }
 
-    /// Queues `ray`, traced with `params`, under `tag`.
+    /// Queues `ray`, traced with `params`, under `tag`: written in place as rows of lanes,
+    /// which the clipping kernels load a vector at a time, rather than kept as a record
+    /// and copied into rows when the stream is full.
+    #[inline(always)]
     pub fn queue(&mut self, tag: usize, ray: Ray, params: TraceParams) {
-        self.queued.push((tag, ray, params));
+        self.queued.push(tag);
+        // A step cap past 2^24 rounds as an f32, but every march caps it at 2^24 (which
+        // an f32 holds exactly) first, so the march is the same.
+        self.rows.push([
+            ray.origin.x,
+            ray.origin.y,
+            ray.origin.z,
+            ray.dir.x,
+            ray.dir.y,
+            ray.dir.z,
+            params.eps_abs,
+            params.eps_rel,
+            params.t_min,
+            params.t_max,
+            params.max_steps as f32,
+        ]);
     }
 
-    /// Takes the buffer of rows and fills it with the queued rays, `lanes` to a group
-    /// ([`fill_lane_groups`], which says why every group is written before a kernel loads
-    /// the first); the kernel hands the buffer back to [`MarchBatch::rows`].
-    fn fill_rows(&mut self, lanes: usize) -> Vec<[[f32; MAX_LANES]; RAY_ROWS]> {
-        let mut rows = std::mem::take(&mut self.rows);
-        let records = self.queued.iter().map(|(_, ray, p)| {
-            [
-                ray.origin.x,
-                ray.origin.y,
-                ray.origin.z,
-                ray.dir.x,
-                ray.dir.y,
-                ray.dir.z,
-                p.eps_abs,
-                p.eps_rel,
-                p.t_min,
-                p.t_max,
-                p.max_steps as f32,
-            ]
-        });
-        fill_lane_groups(records, lanes, &mut rows);
-        rows
+    /// The queued rays a vector of `lanes` at a time (`lanes` divides [`MAX_LANES`]): each
+    /// vector's range of queue indices, its group of rows, and the lane of the group its
+    /// first ray stands in. Lanes past the last ray hold earlier rays or zeros (finite),
+    /// for the kernel to ignore.
+    fn vectors(
+        queued: usize,
+        rows: &LaneGroups<RAY_ROWS>,
+        lanes: usize,
+    ) -> impl Iterator<Item = (Range<usize>, &[[f32; MAX_LANES]; RAY_ROWS], usize)> {
+        (0..queued).step_by(lanes).map(move |start| {
+            let group = &rows.groups()[start / MAX_LANES];
+            (start..(start + lanes).min(queued), group, start % MAX_LANES)
+        })
     }
 
     /// After [`Geometry::march`], each queued ray's tag, outcome and object hit (`None` on
@@ -218,8 +229,7 @@ impl MarchBatch {
 }
 
 /// Rows of a group of rays in [`MarchBatch::rows`]: the origin, the direction, then the
-/// parameters `eps_abs`, `eps_rel`, `t_min`, `t_max` and the step cap (which only
-/// [`Schedule::Groups`] reads).
+/// parameters `eps_abs`, `eps_rel`, `t_min`, `t_max` and the step cap.
 const RAY_ROWS: usize = 11;
 
 /// Objects per row of [`MarchBatch::kept`]: sums of distinct powers of two are exact in

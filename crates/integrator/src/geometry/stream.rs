@@ -2,6 +2,7 @@
 //! ray's candidates and the range they cover, and `CandidateLanes` is the field a lane's
 //! ray marches through them, a lane taking the next ray as soon as its own ends.
 
+use glam::Vec3;
 use lueur_sdf_math::{
     Lane, LaneKernel, LaneVec3, MAX_LANES, Ray, RayClipLanes, StreamField, TraceOutcome,
     TraceParams,
@@ -30,13 +31,13 @@ impl LaneKernel for Clip<'_> {
             geometry.order.len().div_ceil(OBJECTS_PER_MASK),
             [0.0; MAX_LANES],
         );
-        // Lanes past a short last group are never read (`live`).
-        let rows = batch.fill_rows(lanes);
-        let mut start = 0;
-        for v in &rows {
-            let group = start..(start + lanes).min(batch.queued.len());
-            start = group.end;
-            let row = |i: usize| -> &[f32] { &v[i][..lanes] };
+        let (queued, rows) = (
+            std::mem::take(&mut batch.queued),
+            std::mem::take(&mut batch.rows),
+        );
+        // Lanes past the last ray are never read (`live`).
+        for (group, v, lane0) in MarchBatch::vectors(queued.len(), &rows, lanes) {
+            let row = |i: usize| -> &[f32] { &v[i][lane0..lane0 + lanes] };
             let (t_min, t_max) = (L::load(row(8)), L::load(row(9)));
             let clip = RayClipLanes::from_lanes(
                 LaneVec3::new(L::load(row(0)), L::load(row(1)), L::load(row(2))),
@@ -66,11 +67,12 @@ impl LaneKernel for Clip<'_> {
             lo.store(&mut los[..lanes]);
             hi.store(&mut his[..lanes]);
             let seen = L::bits(seen);
-            for (lane, &(tag, ray, params)) in batch.queued[group].iter().enumerate() {
+            for (lane, &tag) in queued[group].iter().enumerate() {
                 if seen >> lane & 1 == 0 {
                     batch.misses.push(tag);
                     continue;
                 }
+                let at = |i: usize| v[i][lane0 + lane];
                 let (t_min, t_max) = (los[lane], his[lane]);
                 let first = batch.candidates.len() as u32;
                 for (chunk, row) in kept_rows.iter().enumerate() {
@@ -82,17 +84,24 @@ impl LaneKernel for Clip<'_> {
                     }
                 }
                 batch.spans.push((first, batch.candidates.len() as u32));
-                batch.rays.push(ray);
+                batch.rays.push(Ray {
+                    origin: Vec3::new(at(0), at(1), at(2)),
+                    dir: Vec3::new(at(3), at(4), at(5)),
+                });
                 batch.params.push(TraceParams {
                     t_min,
                     t_max,
-                    ..params
+                    // As queued, but for a cap past 2^24, which every march caps at 2^24
+                    // (`MarchBatch::queue`).
+                    max_steps: at(10) as u32,
+                    eps_abs: at(6),
+                    eps_rel: at(7),
                 });
                 batch.tags.push(tag);
             }
         }
         batch.kept = kept_rows;
-        batch.rows = rows;
+        (batch.queued, batch.rows) = (queued, rows);
     }
 }
 
