@@ -1,6 +1,6 @@
 //! `lueur render --stats`: what a render measured about itself, as a table.
 
-use lueur_integrator::{RenderOutput, STEP_BUCKETS};
+use lueur_integrator::{RenderOutput, STEP_BUCKETS, Stage};
 
 /// Prints the statistics of a finished render to standard output.
 pub fn print_stats(out: &RenderOutput) {
@@ -35,6 +35,17 @@ pub fn print_stats(out: &RenderOutput) {
         shares[1],
         shares[2],
     );
+    // The wave's stages, as shares of the same threads' time: the rest is tiles' setup
+    // and the film.
+    if s.stages.total_seconds() > 0.0 {
+        let thread_secs = (secs * threads as f64).max(s.stages.total_seconds());
+        let mut line = String::from("wave stages:");
+        for stage in Stage::ALL {
+            let share = 100.0 * s.stages.seconds(stage) / thread_secs;
+            line.push_str(&format!("  {} {share:.1}%", stage.name()));
+        }
+        println!("{line}");
+    }
     for (name, c) in [
         ("camera", &s.rays.camera),
         ("bounce", &s.rays.bounce),

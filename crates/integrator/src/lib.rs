@@ -58,6 +58,7 @@ mod path;
 mod render;
 mod replicates;
 mod scene;
+mod stages;
 mod strategy;
 mod surface;
 mod trace;
@@ -69,4 +70,5 @@ pub use render::{
 };
 pub use replicates::PixelEstimate;
 pub use scene::{Execution, PreparedScene};
+pub use stages::{Stage, StageTimes};
 pub use trace::{Hit, RayCounters, STEP_BUCKETS, TraceCounters};

@@ -13,6 +13,7 @@ use lueur_sdf_math::{Ray, SimdLevel};
 
 use lueur_sdf_math::TraceParams;
 
+use crate::stages::{Stage, StageClock, StageTimes};
 use crate::strategy::{
     self, CosineScatters, EmissionWeight, Lighting, Scatter, Vertex, VertexReads, VertexSample,
 };
@@ -314,7 +315,7 @@ pub(crate) fn radiance_wave(
     estimator: &Estimator<'_>,
     width: usize,
     next: &mut impl FnMut() -> Option<(SampleId, Ray, Sampler)>,
-    counters: &mut RayCounters,
+    (counters, stages): (&mut RayCounters, &mut StageTimes),
     scratch: &mut WaveScratch,
     estimate: &mut impl FnMut(SampleId, Vec3),
 ) {
@@ -335,6 +336,7 @@ pub(crate) fn radiance_wave(
     s.ended_from = 0;
     s.active.clear();
     let mut dry = false;
+    let mut clock = StageClock::start(stages);
     loop {
         // Hand on the estimates that are next in order.
         while let Some(Some(_)) = s.ended.front() {
@@ -342,6 +344,7 @@ pub(crate) fn radiance_wave(
             estimate(id, l);
             s.ended_from += 1;
         }
+        clock.lap(Stage::Estimates);
         // Start a path in every vacant slot.
         while !dry
             && (!s.vacant.is_empty() || s.paths.len() < width)
@@ -391,7 +394,9 @@ pub(crate) fn radiance_wave(
             ray.maybe_inside = path.depth == 0 && march.camera_inside || path.previous.in_solid;
             ray.camera = path.depth == 0;
         }
+        clock.lap(Stage::StartPaths);
         scene.intersect_rays(&s.rays, tracing, counters, &mut s.trace, &mut s.hits);
+        clock.lap(Stage::PathRays);
 
         // The shading points of the hits that scatter, as one stream.
         s.surface_hits.clear();
@@ -411,6 +416,7 @@ pub(crate) fn radiance_wave(
             &mut s.surface_scratch,
             &mut s.surfaces,
         );
+        clock.lap(Stage::ShadingPoints);
 
         s.pending.clear();
         s.lights.clear();
@@ -483,9 +489,11 @@ pub(crate) fn radiance_wave(
         // The shading below and the scattering after pair each vertex with its shading
         // point by index.
         debug_assert_eq!(s.pending.len(), s.surfaces.len());
+        clock.lap(Stage::VertexNumbers);
         s.lights.draw(tracing.simd, &lighting.emitters);
         s.cosines.draw(tracing.simd);
         s.scatters.draw(tracing.simd);
+        clock.lap(Stage::Draws);
 
         s.shaded.resize(s.pending.len(), Shaded::UNSET);
         s.shadow.rays.clear();
@@ -501,6 +509,7 @@ pub(crate) fn radiance_wave(
                 out,
             );
         }
+        clock.lap(Stage::Shading);
         scene.unoccluded_rays(
             &s.shadow.rays,
             &lighting.params,
@@ -509,6 +518,7 @@ pub(crate) fn radiance_wave(
             &mut s.trace,
             &mut s.free,
         );
+        clock.lap(Stage::ShadowRays);
 
         s.active.clear();
         for (shaded, surface) in s.shaded.iter().zip(&s.surfaces) {
@@ -523,6 +533,7 @@ pub(crate) fn radiance_wave(
                 end(path, slot, &mut s.ended, s.ended_from, &mut s.vacant);
             }
         }
+        clock.lap(Stage::Scattering);
     }
     debug_assert!(s.ended.is_empty(), "every estimate handed on");
 }

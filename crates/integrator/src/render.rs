@@ -14,6 +14,7 @@ use crate::RayCounters;
 use crate::film::{Film, PixelStats};
 use crate::path::{Estimator, SampleId, WaveScratch, radiance_wave};
 use crate::replicates::BlockCounter;
+use crate::stages::StageTimes;
 use crate::strategy::CAMERA_DIMS;
 use crate::surface::March;
 use crate::trace::Tracing;
@@ -30,6 +31,8 @@ const TILE: u32 = 16;
 pub struct RenderStats {
     /// Per kind of ray: rays, steps, hits, misses, step-cap give-ups.
     pub rays: RayCounters,
+    /// Thread time per stage of the wave of paths, summed over threads.
+    pub stages: StageTimes,
     /// Samples that were NaN or infinite and were not added to the film.
     pub dropped_samples: u64,
     /// Samples added to the film.
@@ -49,6 +52,7 @@ impl RenderStats {
     /// Adds another pass's statistics (times add up too).
     pub fn merge(&mut self, other: &RenderStats) {
         self.rays.merge(&other.rays);
+        self.stages.merge(&other.stages);
         self.dropped_samples += other.dropped_samples;
         self.samples += other.samples;
         self.elapsed += other.elapsed;
@@ -266,6 +270,7 @@ pub fn render_pass_in(
             Some(TileCost {
                 samples: r.blocks.iter().flatten().map(|p| u64::from(p.n)).sum(),
                 counters: r.counters,
+                stages: r.stages,
                 dropped: r.dropped,
                 film_time,
             })
@@ -276,6 +281,7 @@ pub fn render_pass_in(
     let mut stats = RenderStats::default();
     for r in results.iter().flatten() {
         stats.rays.merge(&r.counters);
+        stats.stages.merge(&r.stages);
         stats.dropped_samples += r.dropped;
         stats.samples += r.samples;
         stats.film_time += r.film_time;
@@ -297,6 +303,7 @@ struct TileResult {
     /// row-major.
     blocks: Vec<Vec<PixelStats>>,
     counters: RayCounters,
+    stages: StageTimes,
     dropped: u64,
 }
 
@@ -304,6 +311,7 @@ struct TileResult {
 struct TileCost {
     samples: u64,
     counters: RayCounters,
+    stages: StageTimes,
     dropped: u64,
     /// Time spent merging the tile into the film.
     film_time: Duration,
@@ -405,6 +413,7 @@ fn render_tile(
         dropped: 0,
     };
     let mut counters = RayCounters::default();
+    let mut stages = StageTimes::default();
     let wave = estimator.scene.execution().wave.max(1);
     let camera = &estimator.scene.scene().camera;
     let pixels =
@@ -429,7 +438,7 @@ fn render_tile(
         estimator,
         wave,
         &mut next,
-        &mut counters,
+        (&mut counters, &mut stages),
         &mut scratch.wave,
         &mut |id, l| tile.push(id, l),
     );
@@ -450,6 +459,7 @@ fn render_tile(
         height: th,
         blocks,
         counters,
+        stages,
         dropped,
     })
 }
