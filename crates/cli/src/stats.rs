@@ -41,6 +41,10 @@ pub fn print_stats(out: &RenderOutput) {
         let thread_secs = (secs * threads as f64).max(s.stages.total_seconds());
         let mut line = String::from("wave stages:");
         for stage in Stage::ALL {
+            // As below: no shadow rays where the strategy casts none (`mixture`).
+            if stage == Stage::ShadowRays && s.rays.shadow.rays == 0 {
+                continue;
+            }
             let share = 100.0 * s.stages.seconds(stage) / thread_secs;
             line.push_str(&format!("  {} {share:.1}%", stage.name()));
         }

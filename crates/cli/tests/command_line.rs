@@ -442,8 +442,8 @@ fn help_lists_strategies_and_samplers_and_completions_are_generated() {
     }
 }
 
-/// `--stats` on one thread says "1 thread", and shows no row for the
-/// shadow rays that `mixture` never casts.
+/// `--stats` on one thread says "1 thread", and shows no row, nor stage, for
+/// the shadow rays that `mixture` never casts; it shows the other stages.
 #[test]
 fn stats_speak_of_one_thread_and_skip_rays_never_cast() {
     let dir = tempfile::tempdir().unwrap();
@@ -468,6 +468,10 @@ fn stats_speak_of_one_thread_and_skip_rays_never_cast() {
         "{out}"
     );
     assert!(!out.contains("shadow"), "{out}");
+    assert!(
+        out.contains("wave stages:") && out.contains("path rays"),
+        "{out}"
+    );
 }
 
 /// The points plot has a frame (a grey column of pixels as tall as the
