@@ -584,6 +584,8 @@ pub(crate) struct Lighting<'a> {
     pub scene: &'a PreparedScene,
     pub emitters: Emitters<'a>,
     pub params: TraceParams,
+    /// Whether any light is a delta light, which only [`Lighting::delta_lights`] reaches.
+    pub any_delta: bool,
 }
 
 impl<'a> Lighting<'a> {
@@ -594,6 +596,7 @@ impl<'a> Lighting<'a> {
             scene,
             emitters: scene.emitters(settings.quad_sampling),
             params: march.secondary,
+            any_delta: (scene.scene().lights.iter()).any(|l| l.delta_arrival().is_some()),
         }
     }
 
@@ -610,6 +613,10 @@ impl<'a> Lighting<'a> {
         rays: &mut Vec<ShadowRay>,
         contributions: &mut Vec<Vec3>,
     ) {
+        // Most scenes have none: their vertices skip the loop over the lights.
+        if !self.any_delta {
+            return;
+        }
         let (n, wo, origin) = (v.at.n, v.wo, v.at.origin);
         for light in &self.scene.scene().lights {
             let Some((wi, irradiance)) = light.delta_arrival() else {
