@@ -73,16 +73,12 @@ impl LaneKernel for GroupMarch<'_> {
                 sphere_trace_relaxed_group(&mut field, geometry.lipschitz, &rays, OVER_RELAXATION);
             ends.store(&mut outcomes);
             field.last.store(&mut nearest[..lanes]);
-            let marched = L::bits(marched);
-            for (lane, &tag) in queued[group].iter().enumerate() {
-                if marched >> lane & 1 == 0 {
-                    batch.misses.push(tag);
-                } else {
-                    batch.tags.push(tag);
-                    batch.outcomes.push(outcomes[lane]);
-                    batch.nearest.push(nearest[lane] as u32);
-                }
-            }
+            // Every ray of the group as marched, in bulk: a lane not marched holds a miss
+            // in no step, which is what a ray that meets no candidate gets.
+            let n = group.len();
+            batch.tags.extend_from_slice(&queued[group]);
+            batch.outcomes.extend_from_slice(&outcomes[..n]);
+            batch.nearest.extend(nearest[..n].iter().map(|&k| k as u32));
         }
         (batch.queued, batch.rows) = (queued, rows);
     }

@@ -133,7 +133,8 @@ pub(crate) struct MarchBatch {
     queued: Vec<usize>,
     /// The rays queued and their parameters, as rows of lanes ([`MarchBatch::queue`]).
     rows: LaneGroups<RAY_ROWS>,
-    /// The tags of the queued rays that meet no candidate: misses in zero steps.
+    /// The tags of the queued rays that meet no candidate: misses in zero steps. Only the
+    /// stream lists them here; groups keep them among the marched rays, with that outcome.
     misses: Vec<usize>,
     /// Per marched ray: the ray, its parameters clipped to the range its candidates
     /// cover, and its tag.
@@ -210,7 +211,7 @@ impl MarchBatch {
     }
 
     /// After [`Geometry::march`], each queued ray's tag, outcome and object hit (`None` on
-    /// a miss), the rays that met no candidate first.
+    /// a miss), in an order of the schedule's (the callers index by tag).
     pub fn results(&self) -> impl Iterator<Item = (usize, TraceOutcome, Option<usize>)> + '_ {
         let misses = (self.misses.iter()).map(|&tag| (tag, TraceOutcome::Miss { steps: 0 }, None));
         let marched = self.tags.iter().zip(&self.outcomes).zip(&self.nearest).map(
