@@ -8,8 +8,8 @@ use std::time::Instant;
 /// A stage of the wave, in the order a vertex goes through them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stage {
-    /// Paths started in vacant slots: each sample's point in the pixel, its camera ray and
-    /// its copy of the sampler.
+    /// Paths started in vacant slots (each sample's point in the pixel, its camera ray and
+    /// its copy of the sampler), and every path's next ray gathered for the stream.
     StartPaths,
     /// The paths' rays traced as one stream: light tests, clipping, marching.
     PathRays,
