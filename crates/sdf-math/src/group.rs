@@ -13,7 +13,9 @@
 
 use crate::lanes::{Lane, LaneDistance, LaneKernel, LaneVec3, SimdLevel, UnavailableLevel};
 use crate::relaxed::{MAX_STEP_CAP, RelaxedLanes, point_at, status};
-use crate::stream::{MAX_LANES, Shared, fill_lane_groups, sphere_trace_relaxed_stream_at};
+use crate::stream::{
+    MAX_LANES, Shared, assert_one_each, fill_lane_groups, sphere_trace_relaxed_stream_at,
+};
 use crate::trace::outcome;
 #[cfg(doc)]
 use crate::trace::sphere_trace_relaxed;
@@ -173,13 +175,7 @@ where
     if !(omega_max > 1.0 && omega_max.is_finite()) {
         return sphere_trace_relaxed_stream_at(level, field, rays, params, omega_max, out);
     }
-    assert!(
-        rays.len() == params.len() && rays.len() == out.len(),
-        "sphere_trace_relaxed_groups: {} rays, {} parameters, {} outcomes",
-        rays.len(),
-        params.len(),
-        out.len()
-    );
+    assert_one_each("sphere_trace_relaxed_groups", rays, params, out);
     level.dispatch(RelaxedGroups {
         field,
         rays,

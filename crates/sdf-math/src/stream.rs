@@ -219,6 +219,22 @@ where
     sphere_trace_relaxed_stream_of(level, &mut Shared(field), rays, params, omega_max, out)
 }
 
+/// Panics, naming `march`, unless `rays`, `params` and `out` have one entry per ray each.
+pub(crate) fn assert_one_each(
+    march: &str,
+    rays: &[Ray],
+    params: &[TraceParams],
+    out: &[TraceOutcome],
+) {
+    assert!(
+        rays.len() == params.len() && rays.len() == out.len(),
+        "{march}: {} rays, {} parameters, {} outcomes",
+        rays.len(),
+        params.len(),
+        out.len()
+    );
+}
+
 /// [`sphere_trace_relaxed_stream_at`] through a field that may differ per ray: each ray's
 /// outcome is what [`sphere_trace_relaxed`] gives for it through its own field (the plain
 /// march where `omega_max` is not above 1), on every path and for any length of stream.
@@ -233,13 +249,7 @@ pub fn sphere_trace_relaxed_stream_of<F: StreamField>(
     omega_max: f32,
     out: &mut [TraceOutcome],
 ) -> Result<(), UnavailableLevel> {
-    assert!(
-        rays.len() == params.len() && rays.len() == out.len(),
-        "sphere_trace_stream: {} rays, {} parameters, {} outcomes",
-        rays.len(),
-        params.len(),
-        out.len()
-    );
+    assert_one_each("sphere_trace_stream", rays, params, out);
     let lipschitz = field.lipschitz();
     if omega_max > 1.0 && omega_max.is_finite() {
         level.dispatch(RelaxedStream {
