@@ -54,6 +54,7 @@
 mod film;
 mod geometry;
 mod light_sampler;
+mod next_event;
 mod path;
 mod render;
 mod replicates;

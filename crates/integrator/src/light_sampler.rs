@@ -3,7 +3,7 @@
 //! that result, summed over the emitters. The sky is an emitter like the
 //! lights with an area, sampled by the cosine around the normal. And the
 //! direction samples a wave of paths draws together for next-event
-//! estimation: toward sphere lights (`SphereDraws`), rectangles
+//! estimation: toward sphere lights, with their estimates (`SphereNextEvents`), rectangles
 //! (`RectangleDraws`) and the sky (`CosineDraws`).
 
 use glam::{Vec2, Vec3};
@@ -14,7 +14,13 @@ use lueur_sampling::{
 };
 use lueur_sdf_math::{Lane, LaneGroups, LaneKernel, LaneVec3, MAX_LANES, SimdLevel};
 
-use lueur_scene::{EmitterSample, Light, QuadSampling};
+use lueur_scene::{
+    EmitterSample, Light, QuadSampling, SphereLight, sphere_emits_along_lanes, usable_pdf_lanes,
+};
+
+use crate::next_event::{DiffuseLanes, LightSampleLanes, NextEventLanes};
+use crate::surface::ShadowAim;
+use crate::trace::ShadowRay;
 
 /// An emitter that light sampling can choose.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -28,7 +34,7 @@ pub(crate) enum Emitter {
 /// A chosen emitter's direction sample that a wave drew with its others.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Drawn<'a> {
-    /// A light's ([`SphereDraws`], [`RectangleDraws`]).
+    /// A rectangle light's ([`RectangleDraws`]).
     Light(&'a Option<DirectionSample>),
     /// The sky's cosine-weighted direction in the normal's frame: request `k` of the
     /// wave's [`CosineDraws`]. Read where it is used: copied out first, the direction is
@@ -147,16 +153,20 @@ impl Emitters<'_> {
         self.sample_drawn(p, n, u_choice, u, None)
     }
 
-    /// The centre and radius of the light `u_choice` makes [`Emitters::sample`] aim at,
-    /// where that is a sphere light: whose direction sample a wave draws in lanes.
+    /// The light `u_choice` makes [`Emitters::sample`] aim at, where that is a sphere
+    /// light: whose next-event estimates a wave makes in lanes ([`SphereNextEvents`]).
     #[inline]
-    pub fn chosen_sphere(&self, u_choice: f32) -> Option<(Vec3, f32)> {
+    pub fn chosen_sphere(&self, u_choice: f32) -> Option<ChosenSphere> {
         if !self.sampler.spheres {
             return None;
         }
-        match self.sampler.choose(u_choice)?.0 {
-            Emitter::Light(i) => self.lights[i].as_sphere(),
-            Emitter::Sky => None,
+        match self.sampler.choose(u_choice)? {
+            (Emitter::Light(i), pmf) => self.lights[i].as_sphere().map(|sphere| ChosenSphere {
+                light: i,
+                sphere,
+                pmf,
+            }),
+            (Emitter::Sky, _) => None,
         }
     }
 
@@ -350,100 +360,235 @@ impl RectangleDraws {
     }
 }
 
-/// The sphere lights' direction samples that a wave's next-event estimation asks for,
-/// drawn together, a request per lane ([`sample_sphere_light_lanes`]): each is the bits
-/// [`lueur_sampling::sample_sphere_light`] gives for it, whatever its company and the
-/// SIMD level. One sample is a chain of dependent square roots and divisions; in lanes,
-/// a vector of them costs about what one does.
-#[derive(Debug, Default)]
-pub(crate) struct SphereDraws {
-    /// Per request: the shading point, the sphere's centre and radius, `u`.
-    requests: LaneGroups<9>,
-    /// Per request, after [`SphereDraws::draw`]: its sample.
-    pub drawn: Vec<Option<DirectionSample>>,
+/// A sphere light that light sampling chose ([`Emitters::chosen_sphere`]): its index
+/// among the scene's lights, its fields, and the probability of the choice.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ChosenSphere {
+    pub light: usize,
+    pub sphere: SphereLight,
+    pub pmf: f32,
 }
 
-impl SphereDraws {
+/// The next-event estimates toward sphere lights that a wave's diffuse vertices ask for,
+/// made together, a vertex per lane: the light's direction sample
+/// ([`sample_sphere_light_lanes`]), the tests [`Light::sample_drawn`] puts it to, and the
+/// estimate ([`NextEventLanes`]). Each is the bits [`crate::strategy::Lighting::next_event`]
+/// gives for its vertex alone, whatever its company and the SIMD level. One estimate is a
+/// chain of dependent square roots and divisions (the sample's, the shadow ray's, the
+/// weight's); in lanes, a vector of them costs about what one does.
+#[derive(Debug, Default)]
+pub(crate) struct SphereNextEvents {
+    /// Per request: the vertex (shading point, normal, `wo . n`, origin, albedo) and `u`.
+    requests: LaneGroups<15>,
+    /// Per request: which of `spheres` it aims at.
+    aims: Vec<usize>,
+    /// The sphere lights the requests aim at, each once: its index among the scene's
+    /// lights, its fields and the probability of its choice. A scene's few sphere lights
+    /// are looked up here rather than written into every request's rows.
+    spheres: Vec<(usize, SphereLight, f32)>,
+    /// Per group of requests, after [`SphereNextEvents::draw`]: the shadow rays'
+    /// directions and distances, and the contributions, a row each.
+    estimates: Vec<[[f32; MAX_LANES]; 7]>,
+    /// Per request, after [`SphereNextEvents::draw`]: what its estimate came to.
+    outcomes: Vec<SphereNextEvent>,
+}
+
+/// What a vertex's next-event estimate toward a sphere light came to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum SphereNextEvent {
+    /// Nothing, whatever its shadow ray would find.
+    Nothing,
+    /// A shadow ray, and what it brings if free: [`SphereNextEvents::write`] writes them.
+    Found,
+    /// An estimate whose shadow ray does not aim at its point ([`ShadowAim::at_point`]):
+    /// made again alone, by [`crate::strategy::Lighting::next_event`].
+    Alone,
+}
+
+impl SphereNextEvents {
     pub fn clear(&mut self) {
         self.requests.clear();
-        self.drawn.clear();
+        self.aims.clear();
+        self.spheres.clear();
+        self.estimates.clear();
+        self.outcomes.clear();
     }
 
-    /// Asks for a sample of the sphere `(center, radius)` from `p` with `u`; its index in
-    /// `drawn`. Inlined: out of line, its vectors pass through memory, stored in pieces
-    /// and loaded whole, and each load waits for its stores to retire.
+    /// Asks for the estimate of `vertex` toward `chosen` with `u`; its index. Inlined: out
+    /// of line, its vectors pass through memory, stored in pieces and loaded whole, and
+    /// each load waits for its stores to retire.
     #[inline(always)]
-    pub fn request(&mut self, p: Vec3, (center, radius): (Vec3, f32), u: Vec2) -> usize {
+    pub fn request(&mut self, vertex: &DiffuseLanes<f32>, chosen: &ChosenSphere, u: Vec2) -> usize {
+        let aim = match self.spheres.iter().rposition(|s| s.0 == chosen.light) {
+            Some(aim) => aim,
+            None => {
+                self.spheres.push((chosen.light, chosen.sphere, chosen.pmf));
+                self.spheres.len() - 1
+            }
+        };
+        self.aims.push(aim);
+        let v = vertex;
         self.requests.push([
-            p.x, p.y, p.z, center.x, center.y, center.z, radius, u.x, u.y,
+            v.p.x, v.p.y, v.p.z, v.n.x, v.n.y, v.n.z, v.wo_n, v.origin.x, v.origin.y, v.origin.z,
+            v.albedo.x, v.albedo.y, v.albedo.z, u.x, u.y,
         ])
     }
 
-    /// Draws every request's sample on `level` (the widest available where it is not).
+    /// Makes every request's estimate on `level` (the widest available where it is not).
     pub fn draw(&mut self, level: SimdLevel) {
-        self.drawn.clear();
+        self.estimates.clear();
+        self.outcomes.clear();
         if self.requests.is_empty() {
             return;
         }
         // The level is available: `or_widest` says so.
-        let _ = level.or_widest().dispatch(DrawSpheres {
+        let _ = level.or_widest().dispatch(EstimateSpheres {
             rows: self.requests.groups(),
             len: self.requests.len(),
-            drawn: &mut self.drawn,
+            aims: &self.aims,
+            spheres: &self.spheres,
+            estimates: &mut self.estimates,
+            outcomes: &mut self.outcomes,
         });
+    }
+
+    /// What request `k`'s estimate came to.
+    #[inline(always)]
+    pub fn outcome(&self, k: usize) -> SphereNextEvent {
+        self.outcomes[k]
+    }
+
+    /// Writes request `k`'s shadow ray, from `origin` toward light `target`, and what it
+    /// brings if free, into their slots, where its estimate found them. A field at a time:
+    /// records made whole first are stored in pieces and loaded whole, and the loads wait
+    /// for the stores (docs/PERFORMANCE.md, "Stores loaded whole").
+    #[inline(always)]
+    pub fn write(
+        &self,
+        k: usize,
+        (origin, target): (Vec3, usize),
+        ray: &mut ShadowRay,
+        contribution: &mut Vec3,
+    ) {
+        debug_assert_eq!(self.outcomes[k], SphereNextEvent::Found);
+        let (rows, lane) = (&self.estimates[k / MAX_LANES], k % MAX_LANES);
+        ray.ray.origin = origin;
+        ray.ray.dir = Vec3::new(rows[0][lane], rows[1][lane], rows[2][lane]);
+        ray.distance = rows[3][lane];
+        ray.target = Some(target);
+        *contribution = Vec3::new(rows[4][lane], rows[5][lane], rows[6][lane]);
     }
 }
 
-/// The kernel of [`SphereDraws::draw`].
-struct DrawSpheres<'a> {
-    rows: &'a [[[f32; MAX_LANES]; 9]],
+/// The kernel of [`SphereNextEvents::draw`].
+struct EstimateSpheres<'a> {
+    rows: &'a [[[f32; MAX_LANES]; 15]],
     len: usize,
-    drawn: &'a mut Vec<Option<DirectionSample>>,
+    aims: &'a [usize],
+    spheres: &'a [(usize, SphereLight, f32)],
+    estimates: &'a mut Vec<[[f32; MAX_LANES]; 7]>,
+    outcomes: &'a mut Vec<SphereNextEvent>,
 }
 
-impl LaneKernel for DrawSpheres<'_> {
+impl LaneKernel for EstimateSpheres<'_> {
     type Output = ();
 
     #[inline(always)]
     fn run<L: Lane>(self) {
-        let DrawSpheres { rows, len, drawn } = self;
+        let EstimateSpheres {
+            rows,
+            len,
+            aims,
+            spheres,
+            estimates,
+            outcomes,
+        } = self;
         let width = L::LANES.min(MAX_LANES);
         debug_assert_eq!(MAX_LANES % width, 0);
-        let vectors = rows.iter().flat_map(|group| {
-            (0..MAX_LANES)
-                .step_by(width)
-                .map(move |first| (group, first))
-        });
-        for (v, (group, first)) in vectors.enumerate() {
-            let (start, end) = (v * width, ((v + 1) * width).min(len));
-            if start >= end {
-                break;
+        estimates.resize(rows.len(), [[0.0; MAX_LANES]; 7]);
+        for (v, (group, out)) in rows.iter().zip(estimates.iter_mut()).enumerate() {
+            for first in (0..MAX_LANES).step_by(width) {
+                let start = v * MAX_LANES + first;
+                if start >= len {
+                    break;
+                }
+                let end = (start + width).min(len);
+                let mut lanes = [L::splat(0.0); 15 + 8];
+                for (lane, row) in lanes.iter_mut().zip(group) {
+                    *lane = L::load(&row[first..first + width]);
+                }
+                // Each lane's sphere: a vector of one sphere (a scene of one sphere light)
+                // splats it; else each lane's is laid out first.
+                let aims = &aims[start..end];
+                let sphere = |(_, s, pmf): (usize, SphereLight, f32)| {
+                    let (c, r) = (s.center, s.radiance);
+                    [c.x, c.y, c.z, s.radius, r.x, r.y, r.z, pmf]
+                };
+                if aims.iter().all(|&a| a == aims[0]) {
+                    for (lane, value) in lanes[15..].iter_mut().zip(sphere(spheres[aims[0]])) {
+                        *lane = L::splat(value);
+                    }
+                } else {
+                    let mut rows = [[0.0; MAX_LANES]; 8];
+                    for j in 0..width {
+                        let values = sphere(spheres[aims[j.min(aims.len() - 1)]]);
+                        for (row, value) in rows.iter_mut().zip(values) {
+                            row[j] = value;
+                        }
+                    }
+                    for (lane, row) in lanes[15..].iter_mut().zip(&rows) {
+                        *lane = L::load(&row[..width]);
+                    }
+                }
+                let vec3 = |i: usize| LaneVec3::new(lanes[i], lanes[i + 1], lanes[i + 2]);
+                let vertex = DiffuseLanes {
+                    p: vec3(0),
+                    n: vec3(3),
+                    wo_n: lanes[6],
+                    origin: vec3(7),
+                    albedo: vec3(10),
+                };
+                let u = [lanes[13], lanes[14]];
+                let (center, radius, radiance, pmf) = (vec3(15), lanes[18], vec3(19), lanes[22]);
+                let s = sample_sphere_light_lanes(vertex.p, center, radius, u);
+                let sampled = L::and(
+                    s.valid,
+                    L::and(
+                        sphere_emits_along_lanes(s.normal, s.wi),
+                        usable_pdf_lanes(s.pdf),
+                    ),
+                );
+                let sample = LightSampleLanes {
+                    wi: s.wi,
+                    distance: s.distance,
+                    pdf: s.pdf * pmf,
+                    radiance,
+                };
+                let e = NextEventLanes::new(&vertex, &sample);
+                let contribution = e.contribution(&sample);
+                let aim = ShadowAim::new(vertex.p, vertex.origin, sample.wi, sample.distance);
+                let values = [
+                    aim.dir.x,
+                    aim.dir.y,
+                    aim.dir.z,
+                    aim.distance,
+                    contribution.x,
+                    contribution.y,
+                    contribution.z,
+                ];
+                for (row, value) in out.iter_mut().zip(values) {
+                    value.store(&mut row[first..first + width]);
+                }
+                let found = L::bits(L::and(sampled, e.weighs));
+                let at_point = L::bits(aim.at_point);
+                outcomes.extend((0..end - start).map(|lane| {
+                    match (found >> lane & 1 == 1, at_point >> lane & 1 == 1) {
+                        (false, _) => SphereNextEvent::Nothing,
+                        (true, true) => SphereNextEvent::Found,
+                        (true, false) => SphereNextEvent::Alone,
+                    }
+                }));
             }
-            let mut lanes = [L::splat(0.0); 9];
-            for (lane, row) in lanes.iter_mut().zip(group) {
-                *lane = L::load(&row[first..first + width]);
-            }
-            let [px, py, pz, cx, cy, cz, radius, u0, u1] = lanes;
-            let (p, center) = (LaneVec3::new(px, py, pz), LaneVec3::new(cx, cy, cz));
-            let s = sample_sphere_light_lanes(p, center, radius, [u0, u1]);
-            let mut out = [[0f32; MAX_LANES]; 11];
-            let values = [
-                s.wi.x, s.wi.y, s.wi.z, s.distance, s.pdf, s.point.x, s.point.y, s.point.z,
-                s.normal.x, s.normal.y, s.normal.z,
-            ];
-            for (row, v) in out.iter_mut().zip(values) {
-                v.store(&mut row[..width]);
-            }
-            let valid = L::bits(s.valid);
-            drawn.extend((0..end - start).map(|lane| {
-                (valid >> lane & 1 == 1).then(|| DirectionSample {
-                    wi: Vec3::new(out[0][lane], out[1][lane], out[2][lane]),
-                    distance: out[3][lane],
-                    pdf: out[4][lane],
-                    point: Vec3::new(out[5][lane], out[6][lane], out[7][lane]),
-                    normal: Vec3::new(out[8][lane], out[9][lane], out[10][lane]),
-                })
-            }));
         }
     }
 }

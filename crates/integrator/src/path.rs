@@ -21,7 +21,10 @@ use crate::surface::{March, SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::{PathRay, RayCounters, ShadowRay, TraceScratch, Tracing};
 use lueur_scene::RenderSettings;
 
-use crate::light_sampler::{CosineDraws, Drawn, Emitters, RectangleDraws, SphereDraws};
+use crate::light_sampler::{
+    CosineDraws, Drawn, Emitters, RectangleDraws, SphereNextEvent, SphereNextEvents,
+};
+use crate::next_event::DiffuseLanes;
 use crate::{Hit, PreparedScene};
 
 /// State carried from one vertex to the next for weighting emission.
@@ -139,11 +142,12 @@ struct Pending {
     cosine: Option<usize>,
 }
 
-/// Where a wave drew a vertex's light sample: its index in the wave's [`SphereDraws`] or
-/// [`RectangleDraws`], or, toward the sky, in its [`CosineDraws`].
+/// Where a wave drew a vertex's light sample: its index in the wave's
+/// [`SphereNextEvents`] (with the light's index, its shadow ray's target; there the
+/// estimate is made too) or [`RectangleDraws`], or, toward the sky, in its [`CosineDraws`].
 #[derive(Clone, Copy)]
 enum LightDraw {
-    Sphere(usize),
+    Sphere(usize, usize),
     Rectangle(usize),
     Sky(usize),
 }
@@ -151,7 +155,7 @@ enum LightDraw {
 /// The light samples a wave draws together.
 #[derive(Default)]
 struct LightDraws {
-    spheres: SphereDraws,
+    spheres: SphereNextEvents,
     rectangles: RectangleDraws,
 }
 
@@ -161,20 +165,10 @@ impl LightDraws {
         self.rectangles.clear();
     }
 
-    /// Draws every request's sample, spheres on `level`.
+    /// Draws every request's sample, and the spheres' estimates, on `level`.
     fn draw(&mut self, level: SimdLevel, emitters: &Emitters<'_>) {
         self.spheres.draw(level);
         self.rectangles.draw(emitters);
-    }
-
-    /// The sample `light` names, drawn (the sky's among the wave's `cosines`).
-    #[inline(always)]
-    fn drawn<'a>(&'a self, light: LightDraw, cosines: &'a CosineDraws) -> Drawn<'a> {
-        match light {
-            LightDraw::Sphere(k) => Drawn::Light(&self.spheres.drawn[k]),
-            LightDraw::Rectangle(k) => Drawn::Light(&self.rectangles.drawn[k]),
-            LightDraw::Sky(k) => Drawn::Cosine(cosines, k),
-        }
     }
 }
 
@@ -264,17 +258,41 @@ fn shade(
         Material::Lambertian { .. } => {
             lighting.delta_lights(&vertex, &mut shadow.rays, &mut shadow.contributions);
             out.diffuse = true;
-            // Pushed where it is made: moved through an `Option` and an iterator chain,
-            // the ray is stored in pieces and loaded whole, and the load waits for the
-            // stores.
             out.next_event = strategy::uses_next_event(settings.strategy)
-                && match lighting.next_event(&vertex, u, light.map(|l| lights.drawn(l, cosines))) {
-                    Some((ray, contribution)) => {
-                        shadow.rays.push(ray);
-                        shadow.contributions.push(contribution);
-                        true
+                && 'estimate: {
+                    let drawn = match light {
+                        Some(LightDraw::Sphere(k, light)) => match lights.spheres.outcome(k) {
+                            SphereNextEvent::Nothing => break 'estimate false,
+                            SphereNextEvent::Found => {
+                                shadow.rays.push(ShadowRay::UNSET);
+                                shadow.contributions.push(Vec3::ZERO);
+                                lights.spheres.write(
+                                    k,
+                                    (surface.origin, light),
+                                    shadow.rays.last_mut().expect("pushed"),
+                                    shadow.contributions.last_mut().expect("pushed"),
+                                );
+                                break 'estimate true;
+                            }
+                            SphereNextEvent::Alone => None,
+                        },
+                        Some(LightDraw::Rectangle(k)) => {
+                            Some(Drawn::Light(&lights.rectangles.drawn[k]))
+                        }
+                        Some(LightDraw::Sky(k)) => Some(Drawn::Cosine(cosines, k)),
+                        None => None,
+                    };
+                    // Pushed where it is made: moved through an `Option` and an iterator
+                    // chain, the ray is stored in pieces and loaded whole, and the load
+                    // waits for the stores.
+                    match lighting.next_event(&vertex, u, drawn) {
+                        Some((ray, contribution)) => {
+                            shadow.rays.push(ray);
+                            shadow.contributions.push(contribution);
+                            true
+                        }
+                        None => false,
                     }
-                    None => false,
                 };
             let emitters = &lighting.emitters;
             strategy::scatter_into(
@@ -471,9 +489,17 @@ pub(crate) fn radiance_wave(
             let emitters = &lighting.emitters;
             pending.light = if !next_event {
                 None
-            } else if let Some(sphere) = emitters.chosen_sphere(u.emitter_choice) {
-                let k = s.lights.spheres.request(surface.p, sphere, u.emitter);
-                Some(LightDraw::Sphere(k))
+            } else if let Some(chosen) = emitters.chosen_sphere(u.emitter_choice) {
+                let vertex = DiffuseLanes {
+                    p: surface.p.into(),
+                    origin: surface.origin.into(),
+                    n: surface.n.into(),
+                    wo_n: (-path.ray.dir).dot(surface.n),
+                    // Next-event estimation is at diffuse vertices only.
+                    albedo: albedo.unwrap_or_default().into(),
+                };
+                let k = s.lights.spheres.request(&vertex, &chosen, u.emitter);
+                Some(LightDraw::Sphere(k, chosen.light))
             } else if let Some(light) = emitters.chosen_rectangle(u.emitter_choice) {
                 let k = s.lights.rectangles.request(surface.p, light, u.emitter);
                 Some(LightDraw::Rectangle(k))

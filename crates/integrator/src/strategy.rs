@@ -2,18 +2,21 @@
 //! layout of a vertex, one function per strategy returning a [`Scatter`],
 //! next-event estimation and delta lights through a [`Lighting`] context,
 //! and the MIS weights in one place ([`EmissionWeight`],
-//! [`next_event_weight`]). Every function here is a pure function of its
+//! [`next_event_weight_lanes`]). Every function here is a pure function of its
 //! inputs (and the counters it is handed), so a tracer of batches of rays
 //! can call them per ray.
 
 use glam::{Vec2, Vec3};
 use lueur_materials::{CosineScatterLanes, HemisphereSampling, Material};
-use lueur_sampling::{Sampler, power_heuristic, sample_cosine_hemisphere_lanes};
+use lueur_sampling::{
+    Sampler, power_heuristic, power_heuristic_lanes, sample_cosine_hemisphere_lanes,
+};
 use lueur_sdf_math::{
     Lane, LaneGroups, LaneKernel, LaneVec3, MAX_LANES, Ray, SimdLevel, TraceParams,
 };
 
 use crate::light_sampler::{Drawn, Emitters};
+use crate::next_event::{DiffuseLanes, LightSampleLanes, NextEventLanes};
 use crate::surface::{March, SurfacePoint};
 use lueur_scene::{RenderSettings, Strategy};
 
@@ -183,14 +186,15 @@ impl EmissionWeight {
 }
 
 /// The weight of a next-event sample of pdf `light_pdf` against the BSDF
-/// sampling of `mis`, which could have found it with `bsdf_pdf`: the other
+/// sampling of `mis`, which could have found it with `bsdf_pdf`, per lane: the other
 /// half of [`EmissionWeight::PowerHeuristic`].
-pub(crate) fn next_event_weight(light_pdf: f32, bsdf_pdf: f32) -> f32 {
-    power_heuristic(1.0, light_pdf, 1.0, bsdf_pdf)
+#[inline(always)]
+pub(crate) fn next_event_weight_lanes<L: Lane>(light_pdf: L, bsdf_pdf: L) -> L {
+    power_heuristic_lanes(L::splat(1.0), light_pdf, L::splat(1.0), bsdf_pdf)
 }
 
 /// The BSDF sampling that `mis` combines with next-event estimation.
-const MIS_HEMISPHERE: HemisphereSampling = HemisphereSampling::Cosine;
+pub(crate) const MIS_HEMISPHERE: HemisphereSampling = HemisphereSampling::Cosine;
 
 /// Where a path goes next from a vertex.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -639,11 +643,11 @@ impl<'a> Lighting<'a> {
     }
 
     /// Next-event estimation toward one chosen emitter, weighted against `mis`'s BSDF
-    /// sampling by [`next_event_weight`]: what it brings if its shadow ray is free, with
+    /// sampling by [`next_event_weight_lanes`]: what it brings if its shadow ray is free, with
     /// that ray; `None` where it brings nothing whatever the ray finds.
     ///
     /// `drawn` is the chosen emitter's direction sample where the wave drew it already
-    /// ([`crate::light_sampler::SphereDraws`], [`crate::light_sampler::RectangleDraws`],
+    /// ([`crate::light_sampler::SphereNextEvents`], [`crate::light_sampler::RectangleDraws`],
     /// or the sky's in [`crate::light_sampler::CosineDraws`]), `None` otherwise.
     #[inline]
     pub fn next_event(
@@ -652,24 +656,37 @@ impl<'a> Lighting<'a> {
         u: &VertexSample,
         drawn: Option<Drawn<'_>>,
     ) -> Option<(ShadowRay, Vec3)> {
-        let (n, wo) = (v.at.n, v.wo);
         let (es, light) =
             self.emitters
-                .sample_drawn(v.at.p, n, u.emitter_choice, u.emitter, drawn)?;
-        let f = v.material.eval(wo, es.wi, n);
-        let cos = n.dot(es.wi).abs();
-        if f == Vec3::ZERO || cos == 0.0 || es.radiance == Vec3::ZERO {
+                .sample_drawn(v.at.p, v.at.n, u.emitter_choice, u.emitter, drawn)?;
+        // A mirror's BSDF is 0 toward any sampled direction.
+        let Material::Lambertian { albedo } = v.material else {
+            return None;
+        };
+        let vertex = DiffuseLanes {
+            p: v.at.p.into(),
+            origin: v.at.origin.into(),
+            n: v.at.n.into(),
+            wo_n: v.wo.dot(v.at.n),
+            albedo: albedo.into(),
+        };
+        let sample = LightSampleLanes {
+            wi: es.wi.into(),
+            distance: es.distance,
+            pdf: es.pdf,
+            radiance: es.radiance.into(),
+        };
+        let e = NextEventLanes::new(&vertex, &sample);
+        if !e.weighs {
             return None;
         }
         let (ray, distance) = v.at.shadow_ray(es.wi, es.distance);
-        let bsdf_pdf = v.material.pdf(wo, es.wi, n, MIS_HEMISPHERE);
-        let w = next_event_weight(es.pdf, bsdf_pdf);
         let ray = ShadowRay {
             ray,
             distance,
             target: light,
         };
-        Some((ray, f * es.radiance * cos * w / es.pdf))
+        Some((ray, e.contribution(&sample).into()))
     }
 }
 
@@ -680,7 +697,7 @@ mod tests {
     //! normal (`lueur_stats::DirectionBins`), after checking that the pdf
     //! each sample reports is the strategy's pdf at its direction.
     use super::*;
-    use crate::light_sampler::{CosineDraws, RectangleDraws, SphereDraws};
+    use crate::light_sampler::{CosineDraws, RectangleDraws};
     use lueur_sampling::SamplerKind;
     use lueur_scene::{Camera, Light, QuadSampling, Scene};
     use lueur_stats::DirectionBins;
@@ -824,54 +841,134 @@ mod tests {
         }
     }
 
-    /// A wave's sphere-light samples, drawn in lanes, are the bits
-    /// `sample_sphere_light` gives for each alone (and `None` where it gives none), on
-    /// every SIMD level and for any number of requests, after a wave whose requests stay
-    /// in the lanes past this one's: points outside the spheres, inside them, at their
-    /// centres and far away, at the ends of the square.
+    /// A wave's next-event estimates toward sphere lights, made in lanes, are the bits
+    /// [`Lighting::next_event`] gives for each vertex alone (nothing where it gives none;
+    /// the shadow ray's direction and length and what it brings where it aims at its
+    /// point), on every SIMD level and for any number of requests, after a wave whose
+    /// requests stay in the lanes past this one's: points outside the spheres, inside
+    /// them, at their centres and far away, at the ends of the square, viewers on both
+    /// sides, five lights to choose among.
     #[test]
-    fn sphere_draws_are_each_sample_alone() {
+    fn sphere_next_events_are_each_estimate_alone() {
+        use crate::light_sampler::{SphereNextEvent, SphereNextEvents};
+        use crate::next_event::DiffuseLanes;
+        use crate::surface::SurfacePoint;
+        use lueur_sdf_math::Sdf;
+
         let mut u = uniforms(17);
+        let lights: Vec<Light> = (0..5)
+            .map(|_| Light::Sphere {
+                center: Vec3::new(u() - 0.5, 1.0 + u(), u() - 0.5),
+                radius: 0.05 + 0.3 * u(),
+                radiance: Vec3::new(1.0 + u(), 2.0, 0.5 + u()),
+            })
+            .collect();
+        let camera = Camera::new(Vec3::new(0.0, 0.5, 3.0), Vec3::ZERO, Vec3::Y, 40.0).unwrap();
+        let objects = vec![lueur_scene::Object {
+            sdf: Sdf::sphere(0.5),
+            material: 0,
+        }];
+        let albedo = Vec3::new(0.7, 0.4, 0.2);
+        let material = Material::Lambertian { albedo };
+        let scene: PreparedScene = Scene::new(objects, vec![material], lights, None, camera)
+            .unwrap()
+            .into();
+        let lighting = Lighting {
+            scene: &scene,
+            emitters: scene.emitters(QuadSampling::SolidAngle),
+            params: TraceParams::default(),
+            any_delta: false,
+        };
         let ends = [0.0, 0.5, lueur_sampling::ONE_MINUS_EPSILON];
         let mut requests = Vec::new();
         for i in 0..61 {
-            let center = Vec3::new(u() - 0.5, 1.0 + u(), u() - 0.5);
-            let radius = 0.05 + 0.3 * u();
+            let choice = u();
+            let chosen = lighting.emitters.chosen_sphere(choice).unwrap();
+            let (center, radius) = (chosen.sphere.center, chosen.sphere.radius);
             let p = match i % 4 {
                 0 => center + Vec3::new(0.3, -0.2, 0.1) * radius,
                 1 => center,
                 2 => Vec3::new(1e3, -2e3, 5e2),
                 _ => Vec3::new(2.0 * u() - 1.0, 2.0 * u(), 2.0 * u() - 1.0),
             };
+            let n = Vec3::new(u() - 0.5, 1.0, u() - 0.5).normalize();
+            let wo = Vec3::new(u() - 0.5, if i % 3 == 0 { -0.2 } else { 1.0 }, u()).normalize();
+            let at = SurfacePoint {
+                p,
+                n,
+                origin: p + n * 1e-3,
+                inside: false,
+            };
             let e = if i % 7 == 0 {
                 Vec2::new(ends[i % 3], ends[(i / 3) % 3])
             } else {
                 Vec2::new(u(), u())
             };
-            requests.push((p, (center, radius), e));
+            requests.push((at, wo, choice, e));
         }
+        let request =
+            |events: &mut SphereNextEvents,
+             &(at, wo, choice, e): &(SurfacePoint, Vec3, f32, Vec2)| {
+                let vertex = DiffuseLanes {
+                    p: at.p.into(),
+                    origin: at.origin.into(),
+                    n: at.n.into(),
+                    wo_n: wo.dot(at.n),
+                    albedo: albedo.into(),
+                };
+                let chosen = lighting.emitters.chosen_sphere(choice).unwrap();
+                events.request(&vertex, &chosen, e)
+            };
+        let (mut found, mut nothing) = (0, 0);
         for level in SimdLevel::available() {
             for count in [1, 7, 16, 17, requests.len()] {
-                let mut draws = SphereDraws::default();
-                for &(p, sphere, e) in requests.iter().rev() {
-                    draws.request(p, sphere, e);
+                let mut events = SphereNextEvents::default();
+                for r in requests.iter().rev() {
+                    request(&mut events, r);
                 }
-                draws.draw(level);
-                draws.clear();
+                events.draw(level);
+                events.clear();
                 let indices: Vec<usize> = (requests[..count].iter())
-                    .map(|&(p, sphere, e)| draws.request(p, sphere, e))
+                    .map(|r| request(&mut events, r))
                     .collect();
-                draws.draw(level);
-                assert_eq!(draws.drawn.len(), count);
-                for (&k, &(p, (center, radius), e)) in indices.iter().zip(&requests) {
-                    let alone = lueur_sampling::sample_sphere_light(p, center, radius, e);
-                    assert_eq!(
-                        draws.drawn[k], alone,
-                        "{level:?}, {count} requests, p = {p}"
-                    );
+                events.draw(level);
+                for (&k, (at, wo, choice, e)) in indices.iter().zip(&requests) {
+                    let vertex = Vertex {
+                        at,
+                        wo: *wo,
+                        material,
+                    };
+                    let numbers = VertexSample {
+                        emitter_choice: *choice,
+                        emitter: *e,
+                        ..VertexSample::UNSET
+                    };
+                    let alone = lighting.next_event(&vertex, &numbers, None);
+                    let light = lighting.emitters.chosen_sphere(*choice).unwrap().light;
+                    match (events.outcome(k), alone) {
+                        (SphereNextEvent::Nothing, None) => nothing += 1,
+                        (SphereNextEvent::Found, Some((ray, contribution))) => {
+                            let (mut batched, mut brings) = (ShadowRay::UNSET, Vec3::ZERO);
+                            events.write(k, (at.origin, light), &mut batched, &mut brings);
+                            assert_eq!(batched.ray, ray.ray, "{level:?}, p = {}", at.p);
+                            assert_eq!(batched.distance.to_bits(), ray.distance.to_bits());
+                            assert_eq!(batched.target, ray.target);
+                            assert_eq!(brings, contribution, "{level:?}, p = {}", at.p);
+                            found += 1;
+                        }
+                        (SphereNextEvent::Alone, _) => {}
+                        (batched, alone) => panic!(
+                            "{level:?}, {count} requests, p = {}: {batched:?} in lanes, {alone:?} alone",
+                            at.p
+                        ),
+                    }
                 }
             }
         }
+        assert!(
+            found > 0 && nothing > 0,
+            "{found} found, {nothing} with nothing"
+        );
     }
 
     /// A wave's samples by the cosine, drawn in lanes, are the bits `Material::sample`

@@ -38,8 +38,8 @@
 
 use glam::{Vec2, Vec3};
 use lueur_sampling::{
-    Frame, FrameLanes, cosine_hemisphere_pdf, cosine_hemisphere_pdf_lanes,
-    sample_cosine_hemisphere, sample_uniform_hemisphere, uniform_hemisphere_pdf,
+    Frame, FrameLanes, cosine_hemisphere_pdf_lanes, sample_cosine_hemisphere,
+    sample_uniform_hemisphere, uniform_hemisphere_pdf,
 };
 use lueur_sdf_math::{Lane, LaneVec3};
 use std::f32::consts::FRAC_1_PI;
@@ -98,6 +98,61 @@ impl BsdfSample {
 #[inline(always)]
 fn weight_lanes<L: Lane>(f: LaneVec3<L>, n: LaneVec3<L>, wi: LaneVec3<L>, pdf: L) -> LaneVec3<L> {
     f * n.dot(wi).abs() / pdf
+}
+
+/// A Lambertian surface of `albedo` evaluated for a pair of directions, per lane: the one
+/// definition of [`Material::eval`] and [`Material::pdf`] for it, which run it at `f32`,
+/// so that a batch of vertices gets each vertex's bits.
+#[derive(Clone, Copy, Debug)]
+pub struct LambertianLanes<L: Lane> {
+    /// The BSDF's value: `albedo / pi` where `wo` and `wi` are on one side of the
+    /// surface, else 0.
+    pub f: LaneVec3<L>,
+    /// `|n . wi|`.
+    pub cos: L,
+    /// Where `wo` and `wi` are on one side of the surface (the surface is two-sided).
+    pub same_side: L::Mask,
+}
+
+impl<L: Lane> LambertianLanes<L> {
+    /// The surface of `albedo` with normal `n`, seen along `wo`, lit along `wi`.
+    #[inline(always)]
+    pub fn new(
+        albedo: LaneVec3<L>,
+        wo: LaneVec3<L>,
+        wi: LaneVec3<L>,
+        n: LaneVec3<L>,
+    ) -> LambertianLanes<L> {
+        LambertianLanes::seen_at(albedo, wo.dot(n), wi, n)
+    }
+
+    /// [`LambertianLanes::new`] from `wo . n` (`wo_n`) rather than `wo`: all it needs of
+    /// the viewer.
+    #[inline(always)]
+    pub fn seen_at(albedo: LaneVec3<L>, wo_n: L, wi: LaneVec3<L>, n: LaneVec3<L>) -> Self {
+        let zero = L::splat(0.0);
+        let same_side = (wo_n * wi.dot(n)).gt(zero);
+        let f = albedo * L::splat(FRAC_1_PI);
+        LambertianLanes {
+            f: LaneVec3::new(
+                L::select(same_side, f.x, zero),
+                L::select(same_side, f.y, zero),
+                L::select(same_side, f.z, zero),
+            ),
+            cos: n.dot(wi).abs(),
+            same_side,
+        }
+    }
+
+    /// The solid-angle pdf with which [`Material::sample`] returns `wi` by `hemisphere`.
+    #[inline(always)]
+    pub fn pdf(&self, hemisphere: HemisphereSampling) -> L {
+        let pdf = match hemisphere {
+            HemisphereSampling::Uniform => L::splat(uniform_hemisphere_pdf()),
+            HemisphereSampling::Cosine => cosine_hemisphere_pdf_lanes(self.cos),
+        };
+        L::select(self.same_side, pdf, L::splat(0.0))
+    }
 }
 
 /// A Lambertian surface's direction sampled by the cosine, per lane:
@@ -168,30 +223,24 @@ impl Material {
 
     /// BSDF value for the pair of directions; zero for delta lobes and for
     /// directions on opposite sides of the surface.
+    #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
         match *self {
             Material::Lambertian { albedo } => {
-                if same_hemisphere(wo, wi, n) {
-                    albedo * FRAC_1_PI
-                } else {
-                    Vec3::ZERO
-                }
+                let lobe = LambertianLanes::new(albedo.into(), wo.into(), wi.into(), n.into());
+                lobe.f.into()
             }
             Material::Mirror { .. } => Vec3::ZERO,
         }
     }
 
     /// Solid-angle pdf with which [`Material::sample`] returns `wi`.
+    #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3, n: Vec3, hemisphere: HemisphereSampling) -> f32 {
         match *self {
             Material::Lambertian { .. } => {
-                if !same_hemisphere(wo, wi, n) {
-                    return 0.0;
-                }
-                match hemisphere {
-                    HemisphereSampling::Uniform => uniform_hemisphere_pdf(),
-                    HemisphereSampling::Cosine => cosine_hemisphere_pdf(n.dot(wi).abs()),
-                }
+                let lobe = LambertianLanes::new(Vec3::ZERO.into(), wo.into(), wi.into(), n.into());
+                lobe.pdf(hemisphere)
             }
             Material::Mirror { .. } => 0.0,
         }
@@ -254,10 +303,6 @@ impl Material {
 /// Mirror reflection of `wo` (pointing away from the surface) about `n`.
 pub fn reflect(wo: Vec3, n: Vec3) -> Vec3 {
     (2.0 * wo.dot(n) * n - wo).normalize()
-}
-
-fn same_hemisphere(wo: Vec3, wi: Vec3, n: Vec3) -> bool {
-    wo.dot(n) * wi.dot(n) > 0.0
 }
 
 #[cfg(test)]

@@ -88,7 +88,7 @@ pub use discrete::DiscreteDistribution;
 pub use frame::{Frame, FrameLanes};
 pub use light::{DirectionSample, DirectionSampleLanes};
 pub use math::ONE_MINUS_EPSILON;
-pub use mis::{balance_heuristic, power_heuristic};
+pub use mis::{balance_heuristic, power_heuristic, power_heuristic_lanes};
 pub use quad_light::{
     RECTANGLE_LANES, RectangleFrame, SphericalRectangle, SphericalRectangles, polygon_irradiance,
     quad_area_pdf, quad_solid_angle_pdf, sample_quad_area, sample_quad_solid_angle,

@@ -57,7 +57,9 @@ mod shape;
 pub use camera::Camera;
 pub use error::SceneFileError;
 pub use file::{SceneFile, parse_scene, parse_scene_with};
-pub use light::{EmitterSample, Light, QuadSampling};
+pub use light::{
+    EmitterSample, Light, QuadSampling, SphereLight, sphere_emits_along_lanes, usable_pdf_lanes,
+};
 pub use model::{Object, Scene, SceneError};
 pub use settings::{
     DEFAULT_REPLICATES, MAX_IMAGE_SIDE, MAX_PIXELS, MAX_SPP, Marching, RenderError, RenderSettings,

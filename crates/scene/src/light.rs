@@ -208,11 +208,21 @@ impl Light {
         self.sample_drawn(p, u, quad_sampling, None)
     }
 
-    /// A sphere light's centre and radius: what a renderer needs to draw its direction
-    /// samples in batches ([`lueur_sampling::sample_sphere_light_lanes`]).
-    pub fn as_sphere(&self) -> Option<(Vec3, f32)> {
+    /// A sphere light's centre, radius and radiance: what a renderer needs to draw its
+    /// direction samples in batches ([`lueur_sampling::sample_sphere_light_lanes`]) and
+    /// weigh them as [`Light::sample_drawn`] does ([`sphere_emits_along_lanes`],
+    /// [`usable_pdf_lanes`]).
+    pub fn as_sphere(&self) -> Option<SphereLight> {
         match *self {
-            Light::Sphere { center, radius, .. } => Some((center, radius)),
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => Some(SphereLight {
+                center,
+                radius,
+                radiance,
+            }),
             Light::Quad { .. } | Light::Directional { .. } => None,
         }
     }
@@ -256,8 +266,7 @@ impl Light {
                     Some(s) => (*s)?,
                     None => sample_sphere_light(p, center, radius, u)?,
                 };
-                // Only the outward face emits.
-                if s.normal.dot(s.wi) >= 0.0 {
+                if !sphere_emits_along_lanes::<f32>(s.normal.into(), s.wi.into()) {
                     return None;
                 }
                 (s, radiance)
@@ -282,7 +291,7 @@ impl Light {
             }
             Light::Directional { .. } => return None,
         };
-        if !(s.pdf > 0.0) || !s.pdf.is_finite() {
+        if !usable_pdf_lanes(s.pdf) {
             return None;
         }
         Some(EmitterSample {
@@ -415,6 +424,32 @@ pub(crate) fn ray_quad_lanes<L: Lane>(
     // it would skip.
     let within = L::and(L::and(s.ge(zero), nn.ge(s)), L::and(r.ge(zero), nn.ge(r)));
     (t, L::and(L::and(t.gt(zero), t.finite()), within))
+}
+
+/// A sphere light's fields ([`Light::as_sphere`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereLight {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius.
+    pub radius: f32,
+    /// Emitted radiance, from the outward face.
+    pub radiance: Vec3,
+}
+
+/// Where a sphere light's direction sample `wi` meets the sphere on its emitting face (the
+/// outward one, whose normal there is `normal`), per lane: the one definition of
+/// [`Light::sample_drawn`]'s test, which runs it at `f32`.
+#[inline(always)]
+pub fn sphere_emits_along_lanes<L: Lane>(normal: LaneVec3<L>, wi: LaneVec3<L>) -> L::Mask {
+    L::not(normal.dot(wi).ge(L::splat(0.0)))
+}
+
+/// Where a light sample's pdf can weigh it (positive and finite), per lane: the one
+/// definition of [`Light::sample_drawn`]'s test, which runs it at `f32`.
+#[inline(always)]
+pub fn usable_pdf_lanes<L: Lane>(pdf: L) -> L::Mask {
+    L::and(pdf.gt(L::splat(0.0)), pdf.finite())
 }
 
 #[cfg(test)]

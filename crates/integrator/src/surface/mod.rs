@@ -626,19 +626,44 @@ impl SurfacePoint {
     /// `p`, and the distance to it from the ray's origin.
     pub fn shadow_ray(&self, wi: Vec3, distance: f32) -> (Ray, f32) {
         if distance.is_finite() {
-            let to = self.p + wi * distance - self.origin;
-            let d = to.length();
-            if d > 0.0 && d.is_finite() {
+            let aim = ShadowAim::new(self.p.into(), self.origin.into(), wi.into(), distance);
+            if aim.at_point {
                 // Unit already: `Ray::new` would take the square root and divide again,
                 // a chain the shading of the vertex waits on.
                 let ray = Ray {
                     origin: self.origin,
-                    dir: to / d,
+                    dir: aim.dir.into(),
                 };
-                return (ray, d);
+                return (ray, aim.distance);
             }
         }
         (Ray::new(self.origin, wi), distance)
+    }
+}
+
+/// [`SurfacePoint::shadow_ray`]'s aim at the point `distance` along `wi` from `p`, per
+/// lane, from the origin rays leave from: its one definition where the point is finite
+/// and apart from the origin (`at_point`); elsewhere the ray is `wi` from the origin.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ShadowAim<L: Lane> {
+    /// The unit direction from the origin to the point.
+    pub dir: LaneVec3<L>,
+    /// The distance from the origin to the point.
+    pub distance: L,
+    /// Where `dir` and `distance` hold.
+    pub at_point: L::Mask,
+}
+
+impl<L: Lane> ShadowAim<L> {
+    #[inline(always)]
+    pub fn new(p: LaneVec3<L>, origin: LaneVec3<L>, wi: LaneVec3<L>, distance: L) -> Self {
+        let to = p + wi * distance - origin;
+        let d = to.length();
+        ShadowAim {
+            dir: to / d,
+            distance: d,
+            at_point: L::and(distance.finite(), L::and(d.gt(L::splat(0.0)), d.finite())),
+        }
     }
 }
 
