@@ -77,6 +77,30 @@ impl<L: Lane> GroupEnds<L> {
         *going = L::and(*going, L::not(ended));
     }
 
+    /// The lanes whose march ended on a hit.
+    #[inline(always)]
+    pub fn hit(&self) -> L::Mask {
+        is_status(self.status, status::HIT)
+    }
+
+    /// The lanes whose march gave up: at the step cap, or on a ray that cannot move.
+    #[inline(always)]
+    pub fn gave_up(&self) -> L::Mask {
+        is_status(self.status, status::GAVE_UP)
+    }
+
+    /// Where each lane's march ended (its [`TraceOutcome`]'s `t`, where it has one).
+    #[inline(always)]
+    pub fn t(&self) -> L {
+        self.t
+    }
+
+    /// The steps (field evaluations) each lane's march took.
+    #[inline(always)]
+    pub fn steps(&self) -> L {
+        self.steps
+    }
+
     /// The outcome of each lane's march, in its lane's place; `out` holds at least
     /// `L::LANES` outcomes.
     #[inline(always)]
@@ -93,6 +117,15 @@ impl<L: Lane> GroupEnds<L> {
                 .unwrap_or(TraceOutcome::Miss { steps: 0 });
         }
     }
+}
+
+/// The lanes whose status is `value` (statuses are small integers, exact in `f32`).
+#[inline(always)]
+fn is_status<L: Lane>(status: L, value: f32) -> L::Mask {
+    L::and(
+        status.ge(L::splat(value)),
+        L::not(status.gt(L::splat(value))),
+    )
 }
 
 /// Traces each lane's ray of `rays` through `field` by over-relaxed sphere tracing with

@@ -3,8 +3,8 @@
 //! candidates as lane masks and the march's state in registers.
 
 use lueur_sdf_math::{
-    GroupField, GroupRays, Lane, LaneKernel, LaneVec3, MAX_LANES, OVER_RELAXATION, RayClipLanes,
-    TraceOutcome, sphere_trace_relaxed_group,
+    GroupEnds, GroupField, GroupRays, Lane, LaneKernel, LaneVec3, MAX_LANES, OVER_RELAXATION,
+    RayClipLanes, TraceOutcome, sphere_trace_relaxed_group,
 };
 
 #[cfg(doc)]
@@ -34,45 +34,21 @@ impl LaneKernel for GroupMarch<'_> {
         let mut nearest = [0f32; MAX_LANES];
         for (group, v, lane0) in MarchBatch::vectors(queued.len(), &rows, lanes) {
             let row = |i: usize| -> L { L::load(&v[i][lane0..lane0 + lanes]) };
-            let (origin, dir) = (
-                LaneVec3::new(row(0), row(1), row(2)),
-                LaneVec3::new(row(3), row(4), row(5)),
-            );
-            let (eps_abs, eps_rel, t_min, t_max) = (row(6), row(7), row(8), row(9));
-            let clip = RayClipLanes::from_lanes(origin, dir, [eps_abs, eps_rel, t_min, t_max]);
-            let live = u32::MAX >> (32 - group.len());
-            let mut field = GroupCandidates {
-                geometry,
-                keep: [L::splat(0.0).gt(L::splat(0.0)); MAX_GROUP_OBJECTS],
-                first: L::splat(0.0),
-                last: L::splat(0.0),
-            };
-            let mut covered = Covered::<L>::new();
-            for (k, entry) in geometry.order.iter().enumerate() {
-                if let Some(interval) = clip_entry(entry, &clip, live, (t_min, t_max)) {
-                    let first = L::and(interval.2, L::not(covered.seen));
-                    field.first = L::select(first, L::splat(entry.id), field.first);
-                    field.keep[k] = interval.2;
-                    covered.add(interval);
-                }
-            }
             // Lanes past a short last group hold earlier rays: not marched.
             let in_group = L::load(&index[..lanes]).lt(L::splat(group.len() as f32));
-            let marched = L::and(covered.seen, in_group);
             let rays = GroupRays {
-                origin,
-                dir,
-                t_min: covered.lo,
-                t_max: covered.hi,
+                origin: LaneVec3::new(row(0), row(1), row(2)),
+                dir: LaneVec3::new(row(3), row(4), row(5)),
+                eps_abs: row(6),
+                eps_rel: row(7),
+                t_min: row(8),
+                t_max: row(9),
                 max_steps: row(10),
-                eps_abs,
-                eps_rel,
-                live: marched,
+                live: in_group,
             };
-            let ends =
-                sphere_trace_relaxed_group(&mut field, geometry.lipschitz, &rays, OVER_RELAXATION);
+            let (ends, last) = geometry.march_vector(&rays);
             ends.store(&mut outcomes);
-            field.last.store(&mut nearest[..lanes]);
+            last.store(&mut nearest[..lanes]);
             // Every ray of the group as marched, in bulk: a lane not marched holds a miss
             // in no step, which is what a ray that meets no candidate gets.
             let n = group.len();
@@ -81,6 +57,47 @@ impl LaneKernel for GroupMarch<'_> {
             batch.nearest.extend(nearest[..n].iter().map(|&k| k as u32));
         }
         (batch.queued, batch.rows) = (queued, rows);
+    }
+}
+
+impl Geometry {
+    /// A vector of rays, one per lane of `rays.live` (their `t_min` and `t_max` the range
+    /// to clip), clipped against every object's bound and marched through its candidates
+    /// to the end of its last ray: each lane's outcome, and the object nearest where it
+    /// ended (valid where it hit or gave up). A lane that meets no candidate ends as a
+    /// miss in no step. The same outcome for each ray, bit for bit, as the stream gives.
+    #[inline(always)]
+    pub(crate) fn march_vector<L: Lane>(&self, rays: &GroupRays<L>) -> (GroupEnds<L>, L) {
+        let clip = RayClipLanes::from_lanes(
+            rays.origin,
+            rays.dir,
+            [rays.eps_abs, rays.eps_rel, rays.t_min, rays.t_max],
+        );
+        let live = L::bits(rays.live);
+        let mut field = GroupCandidates {
+            geometry: self,
+            keep: [L::splat(0.0).gt(L::splat(0.0)); MAX_GROUP_OBJECTS],
+            first: L::splat(0.0),
+            last: L::splat(0.0),
+        };
+        let mut covered = Covered::<L>::new();
+        for (k, entry) in self.order.iter().enumerate() {
+            if let Some(interval) = clip_entry(entry, &clip, live, (rays.t_min, rays.t_max)) {
+                let first = L::and(interval.2, L::not(covered.seen));
+                field.first = L::select(first, L::splat(entry.id), field.first);
+                field.keep[k] = interval.2;
+                covered.add(interval);
+            }
+        }
+        let marched = GroupRays {
+            t_min: covered.lo,
+            t_max: covered.hi,
+            live: L::and(covered.seen, rays.live),
+            ..*rays
+        };
+        let ends =
+            sphere_trace_relaxed_group(&mut field, self.lipschitz, &marched, OVER_RELAXATION);
+        (ends, field.last)
     }
 }
 
