@@ -155,6 +155,12 @@ struct RenderArgs {
     /// does not depend on it; for measuring and testing.
     #[arg(long, value_name = "PATHS")]
     wave: Option<usize>,
+    /// Keep each path as a record between the wave's stages, even where the lane
+    /// wave could keep it in a lane of the vectors (mis, one sphere light, boxes,
+    /// spheres and planes). The image does not depend on it; for measuring and
+    /// testing.
+    #[arg(long)]
+    no_lane_wave: bool,
     /// Stop at this wall-clock budget in seconds: passes of 1, 1, 2, 4, ...
     /// spp (none after the first shorter than 0.3 s), the last ones cut to what
     /// is left (the first always runs).

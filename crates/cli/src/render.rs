@@ -255,9 +255,13 @@ fn reference_for(
 
 /// The sample indices to render: a shard's (`--sample-range`, which needs
 /// a checkpoint to save it in), or all of `0..spp`.
-/// How the render runs: `--simd`, checked against what this CPU has, and `--wave`.
+/// How the render runs: `--simd`, checked against what this CPU has, `--wave` and
+/// `--no-lane-wave`.
 fn execution(args: &RenderArgs) -> Result<Execution> {
-    let mut execution = Execution::default();
+    let mut execution = Execution {
+        lane_wave: !args.no_lane_wave,
+        ..Execution::default()
+    };
     match args.wave {
         Some(0) => bail!(BadInput("--wave must be at least 1".into())),
         Some(wave) => execution.wave = wave,

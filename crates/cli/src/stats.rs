@@ -19,6 +19,10 @@ pub fn print_stats(out: &RenderOutput) {
             level.lanes()
         );
     }
+    println!(
+        "paths kept as    {:>14}",
+        if s.lane_wave { "lanes" } else { "records" }
+    );
     // Shares of the threads' time: tracing measured per stream of rays, the
     // film merge measured, the rest (camera rays, shading, sampling, the
     // point set, scheduling) by difference.

@@ -16,7 +16,9 @@
 //! so the five ways of choosing a direction share everything else (tracing,
 //! mirrors, Russian roulette, directional lights) and differ only where the
 //! report says they do; the wave of paths (`path.rs`) strings the stages
-//! together, tracing each kind of ray as one SIMD stream.
+//! together, tracing each kind of ray as one SIMD stream, and where the scene
+//! allows, the lane wave (`lane_wave/`) runs the same stages with each path
+//! kept in a lane of the vectors, for the same bits.
 //!
 //! Contracts: renders are deterministic (same scene, settings and seed give
 //! the same film bit for bit, whatever the thread count, the SIMD level or
@@ -53,6 +55,7 @@
 
 mod film;
 mod geometry;
+mod lane_wave;
 mod light_sampler;
 mod next_event;
 mod path;

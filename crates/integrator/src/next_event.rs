@@ -83,6 +83,6 @@ fn is_zero<L: Lane>(x: L) -> L::Mask {
 
 /// Where every coordinate is 0: glam's `== Vec3::ZERO`.
 #[inline(always)]
-fn all_zero<L: Lane>(v: LaneVec3<L>) -> L::Mask {
+pub(crate) fn all_zero<L: Lane>(v: LaneVec3<L>) -> L::Mask {
     L::and(L::and(is_zero(v.x), is_zero(v.y)), is_zero(v.z))
 }

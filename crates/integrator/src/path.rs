@@ -9,7 +9,7 @@ use std::collections::VecDeque;
 use glam::Vec3;
 use lueur_materials::Material;
 use lueur_sampling::Sampler;
-use lueur_sdf_math::{Ray, SimdLevel};
+use lueur_sdf_math::{Lane, LaneVec3, Ray, SimdLevel};
 
 use lueur_sdf_math::TraceParams;
 
@@ -29,17 +29,17 @@ use crate::{Hit, PreparedScene};
 
 /// State carried from one vertex to the next for weighting emission.
 #[derive(Clone, Copy)]
-struct Previous {
+pub(crate) struct Previous {
     /// Point and facing normal of the last scattering vertex.
-    p: Vec3,
-    n: Vec3,
+    pub p: Vec3,
+    pub n: Vec3,
     /// Whether the path travels inside a solid: it started at a camera
     /// inside an object and every vertex since was shaded on the inside.
     /// (Only then: an outside hit whose coarse normal faces away from the
     /// viewer is rounding, not a way in.)
-    in_solid: bool,
+    pub in_solid: bool,
     /// How emission found along the current ray counts.
-    emission: EmissionWeight,
+    pub emission: EmissionWeight,
 }
 
 impl Previous {
@@ -61,6 +61,9 @@ pub(crate) struct Estimator<'a> {
     pub settings: &'a RenderSettings,
     pub march: March,
     pub tracing: Tracing,
+    /// The lane wave's view of the scene, where it runs ([`crate::lane_wave`]); else the
+    /// wave of this module runs.
+    pub lanes: Option<&'a crate::lane_wave::LaneWave>,
 }
 
 /// Which sample of which pixel a path belongs to.
@@ -312,7 +315,7 @@ fn shade(
 /// wave stops starting paths: bounds a wave's memory when `max_depth` is large, and is
 /// not reached otherwise (a path ends within `max_depth + 1` vertices, and each vertex
 /// starts at most a wave's worth).
-const ENDED_PER_SLOT: usize = 16;
+pub(crate) const ENDED_PER_SLOT: usize = 16;
 
 /// The radiance of the pixel samples `next` gives (each as its id, camera ray and a copy
 /// of the sampler positioned past the camera's dimensions), estimated by one path each,
@@ -342,6 +345,7 @@ pub(crate) fn radiance_wave(
         settings,
         march,
         tracing,
+        ..
     } = *estimator;
     let width = width.max(1);
     let lighting = Lighting::of(scene, settings, &march);
@@ -647,7 +651,7 @@ fn scatter(
 /// What the path gains where it leaves the objects: the sky on a miss, or a
 /// light's surface, weighted as the last scattering event said
 /// ([`EmissionWeight`]).
-fn emission_found(
+pub(crate) fn emission_found(
     lighting: &Lighting<'_>,
     previous: &Previous,
     ray: &Ray,
@@ -686,22 +690,38 @@ fn emission_found(
 
 /// Whether Russian roulette may end a path that has scattered `depth` times (and so
 /// whether its last vertex's roulette number is read).
-fn roulette_applies(depth: u32, roulette_depth: u32) -> bool {
+pub(crate) fn roulette_applies(depth: u32, roulette_depth: u32) -> bool {
     depth >= roulette_depth
 }
 
 /// Russian roulette (pbrt-v4 style) after `roulette_depth` scattering
 /// events, on the throughput's largest component: the surviving throughput,
 /// reweighted by `1 / (1 - q)` so that the estimate stays unbiased, or
-/// `None` where the path ends.
+/// `None` where the path ends. [`roulette_lanes`] at one lane.
 fn roulette(beta: Vec3, depth: u32, roulette_depth: u32, u: f32) -> Option<Vec3> {
+    let (survivor, ends) = roulette_lanes(beta.into(), roulette_applies(depth, roulette_depth), u);
+    (!ends).then(|| survivor.into())
+}
+
+/// Russian roulette per lane, where it `applies`: the throughput `beta` that survives
+/// (unchanged where roulette does not play), and the lanes where the path ends. The one
+/// definition: the scalar [`roulette`] is this at `f32`, and the lane wave runs it on its
+/// vectors.
+#[inline(always)]
+pub(crate) fn roulette_lanes<L: Lane>(
+    beta: LaneVec3<L>,
+    applies: L::Mask,
+    u: L,
+) -> (LaneVec3<L>, L::Mask) {
+    let one = L::splat(1.0);
     let max_beta = beta.max_element();
-    if roulette_applies(depth, roulette_depth) && max_beta < 1.0 {
-        let q = (1.0 - max_beta).max(0.0);
-        if u < q {
-            return None;
-        }
-        return Some(beta / (1.0 - q));
-    }
-    Some(beta)
+    let plays = L::and(applies, max_beta.lt(one));
+    let q = (one - max_beta).max(L::splat(0.0));
+    let survivor = beta / (one - q);
+    let kept = LaneVec3::new(
+        L::select(plays, survivor.x, beta.x),
+        L::select(plays, survivor.y, beta.y),
+        L::select(plays, survivor.z, beta.z),
+    );
+    (kept, L::and(plays, u.lt(q)))
 }

@@ -12,6 +12,7 @@ use rayon::prelude::*;
 
 use crate::RayCounters;
 use crate::film::{Film, PixelStats};
+use crate::lane_wave::{LaneScratch, LaneWave, radiance_lanes};
 use crate::path::{Estimator, SampleId, WaveScratch, radiance_wave};
 use crate::replicates::BlockCounter;
 use crate::stages::StageTimes;
@@ -46,6 +47,8 @@ pub struct RenderStats {
     pub threads: usize,
     /// The instruction set the ray streams ran on (`None` before any pass).
     pub simd: Option<SimdLevel>,
+    /// Whether the paths were kept in lanes from vertex to vertex (`Execution::lane_wave`).
+    pub lane_wave: bool,
 }
 
 impl RenderStats {
@@ -59,6 +62,7 @@ impl RenderStats {
         self.film_time += other.film_time;
         self.threads = self.threads.max(other.threads);
         self.simd = self.simd.or(other.simd);
+        self.lane_wave |= other.lane_wave;
     }
 }
 
@@ -215,7 +219,7 @@ pub fn render_pass_in(
         ));
     }
     let start = Instant::now();
-    let estimator = Estimator {
+    let mut estimator = Estimator {
         scene,
         settings,
         march: March::new(scene, settings),
@@ -225,7 +229,14 @@ pub fn render_pass_in(
                 .filter(|level| level.is_available())
                 .unwrap_or_else(SimdLevel::detect),
         },
+        lanes: None,
     };
+    let lane_wave = scene
+        .execution()
+        .lane_wave
+        .then(|| LaneWave::of(&estimator))
+        .flatten();
+    estimator.lanes = lane_wave.as_ref();
     let tiles_x = w.div_ceil(TILE);
     let tiles: Vec<UVec2> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..tiles_x).map(move |tx| UVec2::new(tx * TILE, ty * TILE)))
@@ -291,6 +302,7 @@ pub fn render_pass_in(
     film.end_pass(plan, TILE, done);
     stats.threads = rayon::current_num_threads();
     stats.simd = Some(estimator.tracing.simd);
+    stats.lane_wave = estimator.lanes.is_some();
     stats.elapsed = start.elapsed();
     Ok(Pass { stats, complete })
 }
@@ -358,6 +370,7 @@ impl TileSink {
 #[derive(Default)]
 struct TileScratch {
     wave: WaveScratch,
+    lanes: LaneScratch,
 }
 
 /// The [`TileScratch`]es of a pass, lent to one tile at a time, so that a thread
@@ -434,14 +447,26 @@ fn render_tile(
         // dimensions, so that its vertices are reached from where it stands.
         Some((id, camera.generate_ray(film_point, w, h), sampler.clone()))
     };
-    radiance_wave(
-        estimator,
-        wave,
-        &mut next,
-        (&mut counters, &mut stages),
-        &mut scratch.wave,
-        &mut |id, l| tile.push(id, l),
-    );
+    if let Some(lanes) = estimator.lanes {
+        radiance_lanes(
+            lanes,
+            estimator,
+            wave,
+            &mut next,
+            (&mut counters, &mut stages),
+            &mut scratch.lanes,
+            &mut |id, l| tile.push(id, l),
+        );
+    } else {
+        radiance_wave(
+            estimator,
+            wave,
+            &mut next,
+            (&mut counters, &mut stages),
+            &mut scratch.wave,
+            &mut |id, l| tile.push(id, l),
+        );
+    }
     if cancelled {
         return None;
     }

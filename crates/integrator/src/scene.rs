@@ -37,6 +37,12 @@ pub struct Execution {
     /// times over, few enough that a wave's rays stay in cache. A path that ends hands its
     /// slot to the next sample, so the streams stay this wide until a tile runs dry.
     pub wave: usize,
+    /// Whether a wave keeps each path in a lane of the vectors from one vertex to the
+    /// next, where the lane wave models the scene (`mis`, one sphere light, boxes, spheres
+    /// and planes: issue 18's Cornell box), rather than as a record that each stage copies
+    /// into lanes and back. The same bits either way; by default in lanes, 1.25x as fast
+    /// on that scene (docs/PERFORMANCE.md, "The lane wave").
+    pub lane_wave: bool,
 }
 
 impl Execution {
@@ -51,6 +57,7 @@ impl Default for Execution {
         Execution {
             simd: SimdLevel::detect(),
             wave: Execution::WAVE,
+            lane_wave: true,
         }
     }
 }

@@ -70,7 +70,7 @@ pub struct TraceCounters {
 pub const STEP_BUCKETS: usize = 10;
 
 impl TraceCounters {
-    fn record(&mut self, outcome: &TraceOutcome) {
+    pub(crate) fn record(&mut self, outcome: &TraceOutcome) {
         self.rays += 1;
         let steps = outcome.steps() as u64;
         self.steps += steps;
@@ -89,12 +89,12 @@ impl TraceCounters {
     }
 
     /// Rays and steps: what the time of a stream is shared by.
-    fn work(&self) -> u64 {
+    pub(crate) fn work(&self) -> u64 {
         self.rays + self.steps
     }
 
     /// Adds the time of a stream that started at `start`.
-    fn timed(&mut self, start: Instant) {
+    pub(crate) fn timed(&mut self, start: Instant) {
         self.tracing_nanos += start.elapsed().as_nanos() as u64;
     }
 
@@ -132,7 +132,7 @@ impl RayCounters {
     }
 
     /// The counters of a path's ray: the camera's, or a bounce's.
-    fn path_ray(&mut self, camera: bool) -> &mut TraceCounters {
+    pub(crate) fn path_ray(&mut self, camera: bool) -> &mut TraceCounters {
         if camera {
             &mut self.camera
         } else {
@@ -144,7 +144,7 @@ impl RayCounters {
     /// and the bounces' counters, shared by the work each kind did in it (rays and
     /// steps, from `before`, the two kinds' work when it started): one stream holds both
     /// kinds, and the clock is read once per stream.
-    fn timed_paths(&mut self, start: Instant, before: [u64; 2]) {
+    pub(crate) fn timed_paths(&mut self, start: Instant, before: [u64; 2]) {
         let nanos = start.elapsed().as_nanos() as u64;
         let camera = self.camera.work() - before[0];
         let bounce = self.bounce.work() - before[1];

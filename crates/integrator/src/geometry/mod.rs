@@ -485,6 +485,12 @@ impl Geometry {
         );
     }
 
+    /// Whether fast marching marches this scene's rays in groups ([`Schedule::Groups`]),
+    /// a vector at a time ([`Geometry::march_vector`]).
+    pub fn marches_in_groups(&self) -> bool {
+        self.schedule == Schedule::Groups
+    }
+
     /// Object `i`'s field as fast marching evaluates it (its transforms folded).
     pub fn prepared(&self, i: usize) -> &PreparedSdf {
         &self.order[self.position[i] as usize].prepared

@@ -1,0 +1,407 @@
+//! The lane wave's kernels: each reads and writes the blocks' rows a vector at a time, and
+//! each lane's values are the bits the scalar wave computes for its path alone (every
+//! formula here is a definition the scalar wave runs at `f32`).
+
+use glam::Vec3;
+use lueur_materials::CosineScatterLanes;
+use lueur_sampling::{sample_cosine_hemisphere_lanes, sample_sphere_light_lanes};
+use lueur_scene::{Light, sphere_emits_along_lanes, usable_pdf_lanes};
+use lueur_sdf_math::{
+    GroupRays, HIT_ULPS, Lane, LaneKernel, LaneVec3, TraceParams, position_rounding_lanes,
+};
+
+use super::rows::{self, Block, LANES, ld, ld_mask, ld3, select3, st, st_mask, st3};
+use crate::geometry::Geometry;
+use crate::next_event::{DiffuseLanes, LightSampleLanes, NextEventLanes, all_zero};
+use crate::path::roulette_lanes;
+use crate::surface::ShadowAim;
+
+/// [`TraceParams::resolving`] per lane: the hit thresholds of `params` raised to what
+/// `f32` resolves at each origin.
+#[inline(always)]
+fn resolving<V: Lane>(eps_abs: V, eps_rel: V, origin: LaneVec3<V>) -> (V, V) {
+    (
+        eps_abs.max(V::splat(HIT_ULPS) * position_rounding_lanes(origin)),
+        eps_rel.max(V::splat(HIT_ULPS * f32::EPSILON)),
+    )
+}
+
+/// `a` where `first`, else `b`.
+#[inline(always)]
+fn pick<V: Lane>(first: V::Mask, a: f32, b: f32) -> V {
+    V::select(first, V::splat(a), V::splat(b))
+}
+
+/// Per coordinate, `a * b`: glam's product of two vectors.
+#[inline(always)]
+fn mul3<V: Lane>(a: LaneVec3<V>, b: LaneVec3<V>) -> LaneVec3<V> {
+    LaneVec3::new(a.x * b.x, a.y * b.y, a.z * b.z)
+}
+
+/// Every live path's ray (`rows::ALIVE`): the nearest light it meets from the point it
+/// leaves, before its far limit, then the objects, marched from its origin to that light
+/// or the far limit, as `PreparedScene::intersect_rays` traces it (the lights' tests in
+/// `LightTests`' order, the march [`Geometry::march_vector`]).
+pub(super) struct PathRays<'a> {
+    pub geometry: &'a Geometry,
+    pub lights: &'a [Light],
+    /// The parameters of camera rays (depth 0) and of the others.
+    pub camera: TraceParams,
+    pub secondary: TraceParams,
+    pub blocks: &'a mut [Block],
+}
+
+impl LaneKernel for PathRays<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<V: Lane>(self) {
+        let PathRays {
+            geometry,
+            lights,
+            camera: c,
+            secondary: s,
+            blocks,
+        } = self;
+        for b in blocks.iter_mut() {
+            for at in (0..LANES).step_by(V::LANES) {
+                let alive = ld_mask::<V>(b, rows::ALIVE, at);
+                if !V::any(alive) {
+                    continue;
+                }
+                let (o, d, from) = (
+                    ld3::<V>(b, rows::O, at),
+                    ld3::<V>(b, rows::D, at),
+                    ld3::<V>(b, rows::FROM, at),
+                );
+                let first = ld::<V>(b, rows::DEPTH, at).lt(V::splat(0.5));
+                let t_max = pick::<V>(first, c.t_max, s.t_max);
+                let (mut best_t, mut best) = (V::splat(0.0), V::splat(-1.0));
+                let mut found = V::splat(0.0).gt(V::splat(0.0));
+                for (i, light) in lights.iter().enumerate() {
+                    let (t, meets) = light.intersect_lanes(from, d);
+                    let nearer = V::and(
+                        V::and(meets, t_max.gt(t)),
+                        V::not(V::and(found, V::not(best_t.gt(t)))),
+                    );
+                    best_t = V::select(nearer, t, best_t);
+                    best = V::select(nearer, V::splat(i as f32), best);
+                    found = V::or(found, nearer);
+                }
+                let (eps_abs, eps_rel) = resolving(
+                    pick::<V>(first, c.eps_abs, s.eps_abs),
+                    pick::<V>(first, c.eps_rel, s.eps_rel),
+                    o,
+                );
+                let rays = GroupRays {
+                    origin: o,
+                    dir: d,
+                    t_min: pick::<V>(first, c.t_min, s.t_min),
+                    t_max: V::select(found, best_t, t_max),
+                    max_steps: pick::<V>(first, c.max_steps as f32, s.max_steps as f32),
+                    eps_abs,
+                    eps_rel,
+                    live: alive,
+                };
+                let (ends, nearest) = geometry.march_vector(&rays);
+                st(ends.t(), b, rows::T, at);
+                st_mask::<V>(ends.hit(), b, rows::HIT, at);
+                st_mask::<V>(ends.gave_up(), b, rows::GAVE_UP, at);
+                st(ends.steps(), b, rows::STEPS, at);
+                st(nearest, b, rows::NEAR, at);
+                st(eps_abs.max(eps_rel * ends.t()), b, rows::SHELL, at);
+                st(best, b, rows::LIGHT, at);
+                st(best_t, b, rows::LIGHT_T, at);
+            }
+        }
+    }
+}
+
+/// The one sphere light next-event estimation aims at: its centre, radius, radiance, and
+/// the probability of its choice.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct AimedSphere {
+    pub center: Vec3,
+    pub radius: f32,
+    pub radiance: Vec3,
+    pub pmf: f32,
+}
+
+/// At every diffuse vertex (`rows::DIFFUSE`): next-event estimation toward the sphere light
+/// (the sample, the tests `Light::sample_drawn` puts it to, the estimate and the shadow
+/// ray's aim, as `SphereNextEvents` makes them), and the BSDF's sample by the cosine
+/// (`CosineScatterLanes`, as `CosineScatters` draws it for `mis`).
+pub(super) struct Shade<'a> {
+    pub sphere: AimedSphere,
+    pub blocks: &'a mut [Block],
+}
+
+impl LaneKernel for Shade<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<V: Lane>(self) {
+        let Shade { sphere, blocks } = self;
+        for b in blocks.iter_mut() {
+            for at in (0..LANES).step_by(V::LANES) {
+                let diffuse = V::and(
+                    ld_mask::<V>(b, rows::SHADE, at),
+                    ld_mask::<V>(b, rows::DIFFUSE, at),
+                );
+                if !V::any(diffuse) {
+                    st(V::splat(0.0), b, rows::NEE, at);
+                    continue;
+                }
+                let (p, n, origin) = (
+                    ld3::<V>(b, rows::P, at),
+                    ld3::<V>(b, rows::N, at),
+                    ld3::<V>(b, rows::ORIGIN, at),
+                );
+                let wo = -ld3::<V>(b, rows::D, at);
+                let albedo = ld3::<V>(b, rows::ALBEDO, at);
+                let vertex = DiffuseLanes {
+                    p,
+                    origin,
+                    n,
+                    wo_n: wo.dot(n),
+                    albedo,
+                };
+                let u = [
+                    ld::<V>(b, rows::U_EMITTER, at),
+                    ld::<V>(b, rows::U_EMITTER + 1, at),
+                ];
+                let s = sample_sphere_light_lanes(
+                    p,
+                    LaneVec3::splat(sphere.center),
+                    V::splat(sphere.radius),
+                    u,
+                );
+                let sampled = V::and(
+                    s.valid,
+                    V::and(
+                        sphere_emits_along_lanes(s.normal, s.wi),
+                        usable_pdf_lanes(s.pdf),
+                    ),
+                );
+                let sample = LightSampleLanes {
+                    wi: s.wi,
+                    distance: s.distance,
+                    pdf: s.pdf * V::splat(sphere.pmf),
+                    radiance: LaneVec3::splat(sphere.radiance),
+                };
+                let e = NextEventLanes::new(&vertex, &sample);
+                let aim = ShadowAim::new(p, origin, sample.wi, sample.distance);
+                let found = V::and(diffuse, V::and(sampled, e.weighs));
+                let state = V::select(
+                    V::and(found, aim.at_point),
+                    V::splat(1.0),
+                    V::select(found, V::splat(2.0), V::splat(0.0)),
+                );
+                st(state, b, rows::NEE, at);
+                st3(aim.dir, b, rows::SD, at);
+                st(aim.distance, b, rows::SDIST, at);
+                st3(e.contribution(&sample), b, rows::C, at);
+
+                let local = sample_cosine_hemisphere_lanes([
+                    ld::<V>(b, rows::U_BSDF, at),
+                    ld::<V>(b, rows::U_BSDF + 1, at),
+                ]);
+                let cs = CosineScatterLanes::new(albedo, wo, n, local);
+                // A mirror's lanes keep the scatter written for them.
+                let wi = select3(diffuse, cs.wi, ld3::<V>(b, rows::WI, at));
+                let weight = select3(diffuse, cs.weight, ld3::<V>(b, rows::WEIGHT, at));
+                let pdf = V::select(diffuse, cs.pdf, ld::<V>(b, rows::WPDF, at));
+                let valid = V::select(
+                    diffuse,
+                    V::select(cs.valid, V::splat(1.0), V::splat(0.0)),
+                    ld::<V>(b, rows::WVALID, at),
+                );
+                st3(wi, b, rows::WI, at);
+                st3(weight, b, rows::WEIGHT, at);
+                st(pdf, b, rows::WPDF, at);
+                st(valid, b, rows::WVALID, at);
+            }
+        }
+    }
+}
+
+/// Every shadow ray next-event estimation found (`rows::NEE` 1): free of objects up to
+/// short of the light, as `PreparedScene::unoccluded_rays` traces it (no other light to
+/// block it: the wave runs scenes of one light).
+pub(super) struct ShadowRays<'a> {
+    pub geometry: &'a Geometry,
+    pub params: TraceParams,
+    pub blocks: &'a mut [Block],
+}
+
+impl LaneKernel for ShadowRays<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<V: Lane>(self) {
+        let ShadowRays {
+            geometry,
+            params,
+            blocks,
+        } = self;
+        for b in blocks.iter_mut() {
+            for at in (0..LANES).step_by(V::LANES) {
+                let state = ld::<V>(b, rows::NEE, at);
+                let found = V::and(state.gt(V::splat(0.5)), state.lt(V::splat(1.5)));
+                if !V::any(found) {
+                    st_mask::<V>(found, b, rows::MARCHED, at);
+                    continue;
+                }
+                let origin = ld3::<V>(b, rows::ORIGIN, at);
+                let (eps_abs, eps_rel) =
+                    resolving(V::splat(params.eps_abs), V::splat(params.eps_rel), origin);
+                // Short of the light's surface, so that its own geometry (for lights that are
+                // objects too) does not occlude it.
+                let distance = ld::<V>(b, rows::SDIST, at);
+                let t_max = (distance * V::splat(1.0 - 1e-4) - eps_abs).min(V::splat(params.t_max));
+                let t_min = V::splat(params.t_min);
+                let marched = V::and(found, V::not(t_min.ge(t_max)));
+                let rays = GroupRays {
+                    origin,
+                    dir: ld3::<V>(b, rows::SD, at),
+                    t_min,
+                    t_max,
+                    max_steps: V::splat(params.max_steps as f32),
+                    eps_abs,
+                    eps_rel,
+                    live: marched,
+                };
+                let (ends, _) = geometry.march_vector(&rays);
+                // A shadow ray that gives up is taken as blocked, as a path ray that gives up
+                // is taken as a hit.
+                let blocked = V::and(marched, V::or(ends.hit(), ends.gave_up()));
+                st_mask::<V>(V::not(blocked), b, rows::FREE, at);
+                st_mask::<V>(marched, b, rows::MARCHED, at);
+                st_mask::<V>(ends.gave_up(), b, rows::S_GAVE_UP, at);
+                st(ends.steps(), b, rows::S_STEPS, at);
+            }
+        }
+    }
+}
+
+/// Every shaded vertex (`rows::SHADE`): what its shadow ray brings, then the scatter,
+/// the throughput, Russian roulette and the next ray, as the scalar wave's `gather` and
+/// `scatter` make them; where the path ends, `rows::ENDED`.
+pub(super) struct Scatter<'a> {
+    pub roulette_depth: u32,
+    pub blocks: &'a mut [Block],
+}
+
+impl LaneKernel for Scatter<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<V: Lane>(self) {
+        let Scatter {
+            roulette_depth,
+            blocks,
+        } = self;
+        for b in blocks.iter_mut() {
+            for at in (0..LANES).step_by(V::LANES) {
+                let shade = ld_mask::<V>(b, rows::SHADE, at);
+                if !V::any(shade) {
+                    continue;
+                }
+                let beta = ld3::<V>(b, rows::BETA, at);
+                let state = ld::<V>(b, rows::NEE, at);
+                let brings = V::and(
+                    V::and(state.gt(V::splat(0.5)), state.lt(V::splat(1.5))),
+                    ld_mask::<V>(b, rows::FREE, at),
+                );
+                let radiance = ld3::<V>(b, rows::L, at);
+                let gathered = radiance + mul3(beta, ld3::<V>(b, rows::C, at));
+                st3(
+                    select3(V::and(shade, brings), gathered, radiance),
+                    b,
+                    rows::L,
+                    at,
+                );
+
+                let scattered = mul3(beta, ld3::<V>(b, rows::WEIGHT, at));
+                let depth = ld::<V>(b, rows::DEPTH, at) + V::splat(1.0);
+                let dark = V::or(all_zero(scattered), V::not(scattered.finite()));
+                let goes = V::and(
+                    V::and(shade, ld_mask::<V>(b, rows::WVALID, at)),
+                    V::not(dark),
+                );
+                let (survivor, killed) = roulette_lanes(
+                    scattered,
+                    depth.ge(V::splat(roulette_depth as f32)),
+                    ld::<V>(b, rows::U_ROULETTE, at),
+                );
+                let next = V::and(goes, V::not(killed));
+                let ended = V::or(
+                    ld_mask::<V>(b, rows::ENDED, at),
+                    V::and(shade, V::not(next)),
+                );
+                st_mask::<V>(ended, b, rows::ENDED, at);
+                if !V::any(next) {
+                    continue;
+                }
+                let wi = ld3::<V>(b, rows::WI, at);
+                // `Ray::new`'s direction: `wi` times the reciprocal of its length.
+                let dir = wi * (V::splat(1.0) / wi.length());
+                st3(select3(next, survivor, beta), b, rows::BETA, at);
+                st(
+                    V::select(next, depth, ld::<V>(b, rows::DEPTH, at)),
+                    b,
+                    rows::DEPTH,
+                    at,
+                );
+                st3(
+                    select3(
+                        next,
+                        ld3::<V>(b, rows::ORIGIN, at),
+                        ld3::<V>(b, rows::O, at),
+                    ),
+                    b,
+                    rows::O,
+                    at,
+                );
+                st3(select3(next, dir, ld3::<V>(b, rows::D, at)), b, rows::D, at);
+                st3(
+                    select3(next, ld3::<V>(b, rows::P, at), ld3::<V>(b, rows::FROM, at)),
+                    b,
+                    rows::FROM,
+                    at,
+                );
+                st3(
+                    select3(
+                        next,
+                        ld3::<V>(b, rows::N, at),
+                        ld3::<V>(b, rows::FROM_N, at),
+                    ),
+                    b,
+                    rows::FROM_N,
+                    at,
+                );
+                let diffuse = ld_mask::<V>(b, rows::DIFFUSE, at);
+                st(
+                    V::select(
+                        next,
+                        V::select(diffuse, V::splat(1.0), V::splat(0.0)),
+                        ld::<V>(b, rows::EMIT_MIS, at),
+                    ),
+                    b,
+                    rows::EMIT_MIS,
+                    at,
+                );
+                st(
+                    V::select(
+                        next,
+                        ld::<V>(b, rows::WPDF, at),
+                        ld::<V>(b, rows::EMIT_PDF, at),
+                    ),
+                    b,
+                    rows::EMIT_PDF,
+                    at,
+                );
+            }
+        }
+    }
+}

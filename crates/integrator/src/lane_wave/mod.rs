@@ -1,0 +1,448 @@
+//! The lane wave: the wave of paths ([`crate::path`]) with each path's state kept in a
+//! lane of a SIMD vector from one vertex to the next, as Mitsuba's and pbrt-v4's wavefront
+//! integrators keep theirs, for the scenes it models (see [`LaneWave::of`]); the other
+//! scenes run the wave of `path.rs`.
+//!
+//! Why: the wave of `path.rs` keeps each path as a record, and every stage that runs in
+//! lanes (the march, the light samples, the BSDF's samples) copies its inputs from the
+//! records into rows of lanes and its outputs back, a lane at a time. That copying cost
+//! about what the lanes saved (docs/PERFORMANCE.md, "Next-event estimation in lanes,
+//! rebuilt"). Here the path state is the rows: blocks of 16 paths, a field per row
+//! ([`rows`]), that each stage's kernel ([`kernels`]) loads and stores a vector at a time.
+//! What stays scalar, per lane, is what branches by path: the sampler's numbers, the shading
+//! points (`SurfacePoint::at_hits`, grouped by object), emission found on a light, a mirror's
+//! bounce, and the paths that end and start.
+//!
+//! Contract: the image is the wave of `path.rs`'s, bit for bit, on every SIMD level, for
+//! any number of paths in flight and threads. Each lane runs the scalar wave's own
+//! definitions (the march [`Geometry::march_vector`], `Light::intersect_lanes`,
+//! `sample_sphere_light_lanes`, `NextEventLanes`, `ShadowAim`, `CosineScatterLanes`,
+//! `roulette_lanes`), which the scalar wave runs at `f32`; `tests/` holds both to it.
+
+mod kernels;
+mod rows;
+
+use std::collections::VecDeque;
+use std::time::Instant;
+
+use glam::Vec3;
+use lueur_materials::{HemisphereSampling, Material};
+use lueur_sampling::Sampler;
+use lueur_scene::{Light, Marching, Strategy};
+use lueur_sdf_math::{DistanceField, Ray, TraceOutcome};
+
+use self::kernels::{AimedSphere, PathRays, Scatter, Shade, ShadowRays};
+use self::rows::{Block, LANES, get3, set3};
+use crate::Hit;
+use crate::PreparedScene;
+use crate::path::{
+    ENDED_PER_SLOT, Estimator, Previous, SampleId, emission_found, roulette_applies,
+};
+use crate::stages::{Stage, StageClock, StageTimes};
+use crate::strategy::{EmissionWeight, Lighting, Vertex, VertexReads, VertexSample};
+use crate::surface::{SurfaceHit, SurfacePoint, SurfaceScratch};
+use crate::trace::RayCounters;
+
+/// What the lane wave needs of a scene it models: the sphere light next-event estimation
+/// aims at.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LaneWave {
+    sphere: AimedSphere,
+}
+
+impl LaneWave {
+    /// The lane wave where it models the render: `mis` with fast marching; one light, a
+    /// sphere, and no sky; objects marched in groups (boxes, spheres and planes, at most
+    /// 32); the camera outside every solid. These are the scenes whose vertices it can
+    /// shade in lanes (the Cornell box of issue 18); it gives the other wave's image, bit
+    /// for bit, so the choice never changes one.
+    pub fn of(estimator: &Estimator<'_>) -> Option<LaneWave> {
+        let Estimator {
+            scene,
+            settings,
+            march,
+            ..
+        } = estimator;
+        let model = scene.scene();
+        let &[Light::Sphere { .. }] = model.lights.as_slice() else {
+            return None;
+        };
+        if settings.strategy != Strategy::Mis
+            || settings.marching != Marching::Fast
+            || model.sky.is_some()
+            || model.objects.is_empty()
+            || march.camera_inside
+            || !scene.geometry.marches_in_groups()
+        {
+            return None;
+        }
+        let lighting = Lighting::of(scene, settings, march);
+        if lighting.emitters.sampler.choice_reads_u() {
+            return None;
+        }
+        let chosen = lighting.emitters.chosen_sphere(0.0)?;
+        Some(LaneWave {
+            sphere: AimedSphere {
+                center: chosen.sphere.center,
+                radius: chosen.sphere.radius,
+                radiance: chosen.sphere.radiance,
+                pmf: chosen.pmf,
+            },
+        })
+    }
+}
+
+/// A lane's path beside its rows: the sample it estimates, its own copy of the sampler,
+/// and the order it started in.
+struct Slot {
+    id: SampleId,
+    sampler: Sampler,
+    ordinal: u64,
+}
+
+/// A thread's buffers for the lane wave, kept from tile to tile.
+#[derive(Default)]
+pub(crate) struct LaneScratch {
+    blocks: Vec<Block>,
+    slots: Vec<Option<Slot>>,
+    ended: VecDeque<Option<(SampleId, Vec3)>>,
+    /// The hits shaded this round, and the lane of each.
+    hits: Vec<(Ray, SurfaceHit)>,
+    lanes: Vec<usize>,
+    surfaces: Vec<SurfacePoint>,
+    surface: SurfaceScratch,
+    /// Lanes waiting for a path (the wave held back while estimates wait).
+    vacant: Vec<usize>,
+}
+
+/// `radiance_wave`'s contract, in lanes: the radiance of the pixel samples `next` gives,
+/// estimated by one path each, handed to `estimate` in the order `next` gave them; up to
+/// `width` paths in flight (rounded up to whole blocks of 16).
+pub(crate) fn radiance_lanes(
+    wave: &LaneWave,
+    estimator: &Estimator<'_>,
+    width: usize,
+    next: &mut impl FnMut() -> Option<(SampleId, Ray, Sampler)>,
+    (counters, stages): (&mut RayCounters, &mut StageTimes),
+    s: &mut LaneScratch,
+    estimate: &mut impl FnMut(SampleId, Vec3),
+) {
+    let Estimator {
+        scene,
+        settings,
+        march,
+        tracing,
+        ..
+    } = *estimator;
+    let level = tracing.simd.or_widest();
+    let lighting = Lighting::of(scene, settings, &march);
+    let blocks = width.max(1).div_ceil(LANES);
+    s.blocks.clear();
+    s.blocks.resize(blocks, rows::EMPTY);
+    s.slots.clear();
+    s.slots.resize_with(blocks * LANES, || None);
+    s.ended.clear();
+    s.vacant.clear();
+    s.vacant.extend((0..blocks * LANES).rev());
+    let (mut started, mut handed) = (0u64, 0u64);
+    let mut dry = false;
+    let mut clock = StageClock::start(stages);
+    loop {
+        // Start a path in every vacant lane, unless too many estimates wait.
+        while !dry && s.ended.len() < ENDED_PER_SLOT * blocks * LANES {
+            let Some(&lane) = s.vacant.last() else {
+                break;
+            };
+            let Some((id, ray, sampler)) = next() else {
+                dry = true;
+                break;
+            };
+            s.vacant.pop();
+            start(&mut s.blocks[lane / LANES], lane % LANES, ray);
+            s.slots[lane] = Some(Slot {
+                id,
+                sampler,
+                ordinal: started,
+            });
+            started += 1;
+            s.ended.push_back(None);
+        }
+        if s.vacant.len() == blocks * LANES {
+            break;
+        }
+        clock.lap(Stage::StartPaths);
+
+        let time = Instant::now();
+        let before = [counters.camera.work(), counters.bounce.work()];
+        // The level is available: `or_widest` says so.
+        let _ = level.dispatch(PathRays {
+            geometry: &scene.geometry,
+            lights: &scene.scene().lights,
+            camera: march.camera,
+            secondary: march.secondary,
+            blocks: &mut s.blocks,
+        });
+        count_path_rays(&s.blocks, counters);
+        counters.timed_paths(time, before);
+        clock.lap(Stage::PathRays);
+
+        // What each path found, and the numbers of each vertex that scatters.
+        s.hits.clear();
+        s.lanes.clear();
+        for (lane, slot) in s.slots.iter_mut().enumerate() {
+            let Some(slot) = slot else {
+                continue;
+            };
+            let b = &mut s.blocks[lane / LANES];
+            let l = lane % LANES;
+            b[rows::SHADE][l] = 0.0;
+            b[rows::ENDED][l] = 0.0;
+            let ray = Ray {
+                origin: get3(b, rows::O, l),
+                dir: get3(b, rows::D, l),
+            };
+            let Some(on_surface) = surface_hit(scene, b, l, &ray) else {
+                let light = b[rows::LIGHT][l];
+                let hit = (light >= 0.0).then(|| Hit::Light {
+                    t: b[rows::LIGHT_T][l],
+                    light: light as usize,
+                });
+                let previous = Previous {
+                    p: get3(b, rows::FROM, l),
+                    n: get3(b, rows::FROM_N, l),
+                    in_solid: false,
+                    emission: if b[rows::EMIT_MIS][l] > 0.0 {
+                        EmissionWeight::PowerHeuristic {
+                            bsdf_pdf: b[rows::EMIT_PDF][l],
+                        }
+                    } else {
+                        EmissionWeight::Full
+                    },
+                };
+                let beta = get3(b, rows::BETA, l);
+                let radiance =
+                    get3(b, rows::L, l) + emission_found(&lighting, &previous, &ray, hit, beta);
+                set3(b, rows::L, l, radiance);
+                b[rows::ENDED][l] = 1.0;
+                continue;
+            };
+            let depth = b[rows::DEPTH][l] as u32;
+            if depth >= settings.max_depth {
+                b[rows::ENDED][l] = 1.0;
+                continue;
+            }
+            let material = material_at(scene, on_surface.object);
+            let (albedo, diffuse) = match material {
+                Material::Lambertian { albedo } => (albedo, true),
+                Material::Mirror { reflectance } => (reflectance, false),
+            };
+            let mut u = VertexSample::UNSET;
+            u.draw(
+                &mut slot.sampler,
+                slot.id.pixel,
+                slot.id.index,
+                depth,
+                VertexReads::of(
+                    settings.strategy,
+                    diffuse,
+                    false,
+                    roulette_applies(depth + 1, settings.roulette_depth),
+                ),
+            );
+            b[rows::SHADE][l] = 1.0;
+            b[rows::DIFFUSE][l] = if diffuse { 1.0 } else { 0.0 };
+            set3(b, rows::ALBEDO, l, albedo);
+            b[rows::U_EMITTER][l] = u.emitter.x;
+            b[rows::U_EMITTER + 1][l] = u.emitter.y;
+            b[rows::U_BSDF][l] = u.bsdf.x;
+            b[rows::U_BSDF + 1][l] = u.bsdf.y;
+            b[rows::U_ROULETTE][l] = u.roulette;
+            s.hits.push((ray, on_surface));
+            s.lanes.push(lane);
+        }
+        clock.lap(Stage::VertexNumbers);
+
+        SurfacePoint::at_hits(
+            scene,
+            &march,
+            level,
+            &s.hits,
+            &mut s.surface,
+            &mut s.surfaces,
+        );
+        for (surface, &lane) in s.surfaces.iter().zip(&s.lanes) {
+            let (b, l) = (&mut s.blocks[lane / LANES], lane % LANES);
+            set3(b, rows::P, l, surface.p);
+            set3(b, rows::N, l, surface.n);
+            set3(b, rows::ORIGIN, l, surface.origin);
+            if b[rows::DIFFUSE][l] > 0.0 {
+                continue;
+            }
+            // A mirror's bounce, as `strategy::mirror` makes it.
+            let material = Material::Mirror {
+                reflectance: get3(b, rows::ALBEDO, l),
+            };
+            let wo = -get3(b, rows::D, l);
+            let bounce =
+                material.sample(wo, surface.n, glam::Vec2::ZERO, HemisphereSampling::Cosine);
+            b[rows::WVALID][l] = if bounce.is_some() { 1.0 } else { 0.0 };
+            if let Some(bounce) = bounce {
+                set3(b, rows::WI, l, bounce.wi);
+                set3(b, rows::WEIGHT, l, bounce.weight(surface.n));
+                b[rows::WPDF][l] = 0.0;
+            }
+        }
+        clock.lap(Stage::ShadingPoints);
+
+        // The level is available: `or_widest` says so.
+        let _ = level.dispatch(Shade {
+            sphere: wave.sphere,
+            blocks: &mut s.blocks,
+        });
+        // An estimate whose shadow ray does not aim at its point, made again alone.
+        for (k, &lane) in s.lanes.iter().enumerate() {
+            let (b, l) = (&mut s.blocks[lane / LANES], lane % LANES);
+            if b[rows::NEE][l] != 2.0 {
+                continue;
+            }
+            let vertex = Vertex {
+                at: &s.surfaces[k],
+                wo: -get3(b, rows::D, l),
+                material: material_at(scene, s.hits[k].1.object),
+            };
+            let mut u = VertexSample::UNSET;
+            u.emitter = glam::Vec2::new(b[rows::U_EMITTER][l], b[rows::U_EMITTER + 1][l]);
+            match lighting.next_event(&vertex, &u, None) {
+                Some((ray, contribution)) => {
+                    b[rows::NEE][l] = 1.0;
+                    set3(b, rows::SD, l, ray.ray.dir);
+                    b[rows::SDIST][l] = ray.distance;
+                    set3(b, rows::C, l, contribution);
+                }
+                None => b[rows::NEE][l] = 0.0,
+            }
+        }
+        clock.lap(Stage::Shading);
+
+        let time = Instant::now();
+        // The level is available: `or_widest` says so.
+        let _ = level.dispatch(ShadowRays {
+            geometry: &scene.geometry,
+            params: lighting.params,
+            blocks: &mut s.blocks,
+        });
+        count_shadow_rays(&s.blocks, &s.lanes, counters);
+        counters.shadow.timed(time);
+        clock.lap(Stage::ShadowRays);
+
+        // The level is available: `or_widest` says so.
+        let _ = level.dispatch(Scatter {
+            roulette_depth: settings.roulette_depth,
+            blocks: &mut s.blocks,
+        });
+        clock.lap(Stage::Scattering);
+
+        // The paths that ended leave their estimates and their lanes.
+        for (lane, slot) in s.slots.iter_mut().enumerate() {
+            let b = &s.blocks[lane / LANES];
+            let l = lane % LANES;
+            if slot.is_none() || b[rows::ENDED][l] == 0.0 {
+                continue;
+            }
+            let Slot { id, ordinal, .. } = slot.take().expect("checked");
+            s.ended[(ordinal - handed) as usize] = Some((id, get3(b, rows::L, l)));
+            s.vacant.push(lane);
+        }
+        for &lane in &s.vacant {
+            let b = &mut s.blocks[lane / LANES];
+            b[rows::ALIVE][lane % LANES] = 0.0;
+            b[rows::SHADE][lane % LANES] = 0.0;
+        }
+        while let Some(Some(_)) = s.ended.front() {
+            let (id, l) = s.ended.pop_front().flatten().expect("an ended path");
+            estimate(id, l);
+            handed += 1;
+        }
+        clock.lap(Stage::Estimates);
+    }
+    debug_assert!(s.ended.is_empty(), "every estimate handed on");
+}
+
+/// A new path in lane `l` of `b`, with its camera ray: as `Path::START`.
+fn start(b: &mut Block, l: usize, ray: Ray) {
+    set3(b, rows::O, l, ray.origin);
+    set3(b, rows::D, l, ray.dir);
+    set3(b, rows::FROM, l, ray.origin);
+    set3(b, rows::FROM_N, l, Vec3::ZERO);
+    set3(b, rows::BETA, l, Vec3::ONE);
+    set3(b, rows::L, l, Vec3::ZERO);
+    b[rows::DEPTH][l] = 0.0;
+    b[rows::EMIT_MIS][l] = 0.0;
+    b[rows::EMIT_PDF][l] = 0.0;
+    b[rows::ALIVE][l] = 1.0;
+}
+
+/// The surface lane `l`'s path ray found, as `PreparedScene::surface_hit` takes it from the
+/// march: a hit, or a ray that gave up at the step cap, where it stopped, its shell
+/// widened to the field there.
+fn surface_hit(scene: &PreparedScene, b: &Block, l: usize, ray: &Ray) -> Option<SurfaceHit> {
+    let (t, object) = (b[rows::T][l], b[rows::NEAR][l] as usize);
+    let mut epsilon = b[rows::SHELL][l];
+    if b[rows::HIT][l] == 0.0 {
+        if b[rows::GAVE_UP][l] == 0.0 || b[rows::STEPS][l] == 0.0 {
+            return None;
+        }
+        let f = scene.prepared(object).distance(ray.at(t)).abs();
+        if f.is_finite() {
+            epsilon = epsilon.max(f);
+        }
+    }
+    Some(SurfaceHit {
+        t,
+        object,
+        epsilon,
+        inside: false,
+    })
+}
+
+fn material_at(scene: &PreparedScene, object: usize) -> Material {
+    let model = scene.scene();
+    model.materials[model.objects[object].material]
+}
+
+/// Each live path ray's march, in its kind's counters.
+fn count_path_rays(blocks: &[Block], counters: &mut RayCounters) {
+    for b in blocks {
+        let live = (b[rows::ALIVE].iter().enumerate()).filter(|&(_, &alive)| alive != 0.0);
+        for (l, _) in live {
+            let (t, steps) = (b[rows::T][l], b[rows::STEPS][l] as u32);
+            let outcome = if b[rows::HIT][l] > 0.0 {
+                TraceOutcome::Hit { t, steps }
+            } else if b[rows::GAVE_UP][l] > 0.0 {
+                TraceOutcome::GaveUp { t, steps }
+            } else {
+                TraceOutcome::Miss { steps }
+            };
+            counters.path_ray(b[rows::DEPTH][l] == 0.0).record(&outcome);
+        }
+    }
+}
+
+/// Each shadow ray marched, in the shadow rays' counters (their `t` is not kept).
+fn count_shadow_rays(blocks: &[Block], lanes: &[usize], counters: &mut RayCounters) {
+    for &lane in lanes {
+        let (b, l) = (&blocks[lane / LANES], lane % LANES);
+        if b[rows::MARCHED][l] == 0.0 {
+            continue;
+        }
+        let steps = b[rows::S_STEPS][l] as u32;
+        let outcome = if b[rows::FREE][l] > 0.0 {
+            TraceOutcome::Miss { steps }
+        } else if b[rows::S_GAVE_UP][l] > 0.0 {
+            TraceOutcome::GaveUp { t: 0.0, steps }
+        } else {
+            TraceOutcome::Hit { t: 0.0, steps }
+        };
+        counters.shadow.record(&outcome);
+    }
+}
