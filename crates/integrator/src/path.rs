@@ -716,6 +716,10 @@ pub(crate) fn roulette_lanes<L: Lane>(
     let one = L::splat(1.0);
     let max_beta = beta.max_element();
     let plays = L::and(applies, max_beta.lt(one));
+    // At one lane, a path that roulette does not play skips the division.
+    if !L::any(plays) {
+        return (beta, plays);
+    }
     let q = (one - max_beta).max(L::splat(0.0));
     let survivor = beta / (one - q);
     let kept = LaneVec3::new(

@@ -37,15 +37,23 @@ fn ratio_weight<L: Lane>(f: L, g: L, beta: u32) -> L {
 #[inline(always)]
 fn heuristic<L: Lane>(nf: L, f_pdf: L, ng: L, g_pdf: L, beta: u32) -> L {
     let f = effective_density(nf, f_pdf);
+    // `f` is 0 or more: not above 0 is 0. (At one lane, the divisions are skipped.)
+    let weighs = f.gt(L::splat(0.0));
+    if !L::any(weighs) {
+        return L::splat(0.0);
+    }
     let g = effective_density(ng, g_pdf);
     let infinite = |x: L| x.gt(L::splat(f32::MAX));
     // Both strategies have a Dirac-like density here: weigh by sample counts alone,
     // which keeps the two weights summing to 1.
     let dirac = L::and(infinite(f), infinite(g));
-    let w = ratio_weight(L::select(dirac, nf, f), L::select(dirac, ng, g), beta);
-    let w = L::select(L::and(dirac, L::not(w.finite())), L::splat(0.5), w);
-    // `f` is 0 or more: not above 0 is 0.
-    L::select(f.gt(L::splat(0.0)), w, L::splat(0.0))
+    let w = if L::any(dirac) {
+        let w = ratio_weight(L::select(dirac, nf, f), L::select(dirac, ng, g), beta);
+        L::select(L::and(dirac, L::not(w.finite())), L::splat(0.5), w)
+    } else {
+        ratio_weight(f, g, beta)
+    };
+    L::select(weighs, w, L::splat(0.0))
 }
 
 /// Veach's balance heuristic (1997, Eq. 9.8): the weight of a sample from
