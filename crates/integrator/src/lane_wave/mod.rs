@@ -182,7 +182,6 @@ pub(crate) fn radiance_lanes(
             secondary: march.secondary,
             blocks: &mut s.blocks,
         });
-        count_path_rays(&s.blocks, counters);
         counters.timed_paths(time, before);
         clock.lap(Stage::PathRays);
 
@@ -196,7 +195,7 @@ pub(crate) fn radiance_lanes(
             let b = &mut s.blocks[lane / LANES];
             let l = lane % LANES;
             b[rows::SHADE][l] = 0.0;
-            b[rows::ENDED][l] = 0.0;
+            count_path_ray(b, l, counters);
             let ray = Ray {
                 origin: get3(b, rows::O, l),
                 dir: get3(b, rows::D, l),
@@ -342,21 +341,22 @@ pub(crate) fn radiance_lanes(
         });
         clock.lap(Stage::Scattering);
 
-        // The paths that ended leave their estimates and their lanes.
-        for (lane, slot) in s.slots.iter_mut().enumerate() {
-            let b = &s.blocks[lane / LANES];
-            let l = lane % LANES;
-            if slot.is_none() || b[rows::ENDED][l] == 0.0 {
-                continue;
+        // The paths that ended leave their estimates and their lanes, found by their rows
+        // (a slot, with its sampler, is large).
+        for (v, b) in s.blocks.iter_mut().enumerate() {
+            for l in 0..LANES {
+                if b[rows::ENDED][l] == 0.0 {
+                    continue;
+                }
+                (b[rows::ENDED][l], b[rows::ALIVE][l], b[rows::SHADE][l]) = (0.0, 0.0, 0.0);
+                let lane = v * LANES + l;
+                let Some(slot) = &s.slots[lane] else {
+                    continue;
+                };
+                s.ended[(slot.ordinal - handed) as usize] = Some((slot.id, get3(b, rows::L, l)));
+                s.slots[lane] = None;
+                s.vacant.push(lane);
             }
-            let Slot { id, ordinal, .. } = slot.take().expect("checked");
-            s.ended[(ordinal - handed) as usize] = Some((id, get3(b, rows::L, l)));
-            s.vacant.push(lane);
-        }
-        for &lane in &s.vacant {
-            let b = &mut s.blocks[lane / LANES];
-            b[rows::ALIVE][lane % LANES] = 0.0;
-            b[rows::SHADE][lane % LANES] = 0.0;
         }
         while let Some(Some(_)) = s.ended.front() {
             let (id, l) = s.ended.pop_front().flatten().expect("an ended path");
@@ -410,22 +410,17 @@ fn material_at(scene: &PreparedScene, object: usize) -> Material {
     model.materials[model.objects[object].material]
 }
 
-/// Each live path ray's march, in its kind's counters.
-fn count_path_rays(blocks: &[Block], counters: &mut RayCounters) {
-    for b in blocks {
-        let live = (b[rows::ALIVE].iter().enumerate()).filter(|&(_, &alive)| alive != 0.0);
-        for (l, _) in live {
-            let (t, steps) = (b[rows::T][l], b[rows::STEPS][l] as u32);
-            let outcome = if b[rows::HIT][l] > 0.0 {
-                TraceOutcome::Hit { t, steps }
-            } else if b[rows::GAVE_UP][l] > 0.0 {
-                TraceOutcome::GaveUp { t, steps }
-            } else {
-                TraceOutcome::Miss { steps }
-            };
-            counters.path_ray(b[rows::DEPTH][l] == 0.0).record(&outcome);
-        }
-    }
+/// Lane `l`'s path ray's march, in its kind's counters.
+fn count_path_ray(b: &Block, l: usize, counters: &mut RayCounters) {
+    let (t, steps) = (b[rows::T][l], b[rows::STEPS][l] as u32);
+    let outcome = if b[rows::HIT][l] > 0.0 {
+        TraceOutcome::Hit { t, steps }
+    } else if b[rows::GAVE_UP][l] > 0.0 {
+        TraceOutcome::GaveUp { t, steps }
+    } else {
+        TraceOutcome::Miss { steps }
+    };
+    counters.path_ray(b[rows::DEPTH][l] == 0.0).record(&outcome);
 }
 
 /// Each shadow ray marched, in the shadow rays' counters (their `t` is not kept).
