@@ -61,6 +61,7 @@ mod next_event;
 mod path;
 mod render;
 mod replicates;
+mod roulette;
 mod scene;
 mod stages;
 mod strategy;

@@ -10,16 +10,13 @@ use glam::{Vec2, Vec3};
 use lueur_sampling::{
     DirectionSample, DiscreteDistribution, Frame, RECTANGLE_LANES, RectangleFrame,
     SphericalRectangles, cosine_hemisphere_pdf, sample_cosine_hemisphere,
-    sample_cosine_hemisphere_lanes, sample_sphere_light_lanes,
+    sample_cosine_hemisphere_lanes,
 };
 use lueur_sdf_math::{Lane, LaneGroups, LaneKernel, LaneVec3, MAX_LANES, SimdLevel};
 
-use lueur_scene::{
-    EmitterSample, Light, QuadSampling, SphereLight, sphere_emits_along_lanes, usable_pdf_lanes,
-};
+use lueur_scene::{EmitterSample, Light, QuadSampling, SphereLight};
 
-use crate::next_event::{DiffuseLanes, LightSampleLanes, NextEventLanes};
-use crate::surface::ShadowAim;
+use crate::next_event::{AimedSphereLanes, DiffuseLanes, sphere_next_event_lanes};
 use crate::trace::ShadowRay;
 
 /// An emitter that light sampling can choose.
@@ -371,7 +368,7 @@ pub(crate) struct ChosenSphere {
 
 /// The next-event estimates toward sphere lights that a wave's diffuse vertices ask for,
 /// made together, a vertex per lane: the light's direction sample
-/// ([`sample_sphere_light_lanes`]), the tests [`Light::sample_drawn`] puts it to, and the
+/// ([`lueur_sampling::sample_sphere_light_lanes`]), the tests [`Light::sample_drawn`] puts it to, and the
 /// estimate ([`NextEventLanes`]). Each is the bits [`crate::strategy::Lighting::next_event`]
 /// gives for its vertex alone, whatever its company and the SIMD level. One estimate is a
 /// chain of dependent square roots and divisions (the sample's, the shadow ray's, the
@@ -400,7 +397,7 @@ pub(crate) enum SphereNextEvent {
     Nothing,
     /// A shadow ray, and what it brings if free: [`SphereNextEvents::write`] writes them.
     Found,
-    /// An estimate whose shadow ray does not aim at its point ([`ShadowAim::at_point`]):
+    /// An estimate whose shadow ray does not aim at its point ([`crate::surface::ShadowAim::at_point`]):
     /// made again alone, by [`crate::strategy::Lighting::next_event`].
     Alone,
 }
@@ -550,23 +547,13 @@ impl LaneKernel for EstimateSpheres<'_> {
                 };
                 let u = [lanes[13], lanes[14]];
                 let (center, radius, radiance, pmf) = (vec3(15), lanes[18], vec3(19), lanes[22]);
-                let s = sample_sphere_light_lanes(vertex.p, center, radius, u);
-                let sampled = L::and(
-                    s.valid,
-                    L::and(
-                        sphere_emits_along_lanes(s.normal, s.wi),
-                        usable_pdf_lanes(s.pdf),
-                    ),
-                );
-                let sample = LightSampleLanes {
-                    wi: s.wi,
-                    distance: s.distance,
-                    pdf: s.pdf * pmf,
+                let sphere = AimedSphereLanes {
+                    center,
+                    radius,
                     radiance,
+                    pmf,
                 };
-                let e = NextEventLanes::new(&vertex, &sample);
-                let contribution = e.contribution(&sample);
-                let aim = ShadowAim::new(vertex.p, vertex.origin, sample.wi, sample.distance);
+                let (found, aim, contribution) = sphere_next_event_lanes(&vertex, &sphere, u);
                 let values = [
                     aim.dir.x,
                     aim.dir.y,
@@ -579,7 +566,7 @@ impl LaneKernel for EstimateSpheres<'_> {
                 for (row, value) in out.iter_mut().zip(values) {
                     value.store(&mut row[first..first + width]);
                 }
-                let found = L::bits(L::and(sampled, e.weighs));
+                let found = L::bits(found);
                 let at_point = L::bits(aim.at_point);
                 outcomes.extend((0..end - start).map(|lane| {
                     match (found >> lane & 1 == 1, at_point >> lane & 1 == 1) {

@@ -5,9 +5,12 @@
 //! each vertex gets the bits it has alone.
 
 use lueur_materials::LambertianLanes;
+use lueur_sampling::sample_sphere_light_lanes;
+use lueur_scene::{sphere_emits_along_lanes, usable_pdf_lanes};
 use lueur_sdf_math::{Lane, LaneVec3};
 
 use crate::strategy::{MIS_HEMISPHERE, next_event_weight_lanes};
+use crate::surface::ShadowAim;
 
 /// A diffuse vertex as next-event estimation sees it, per lane.
 #[derive(Clone, Copy, Debug)]
@@ -73,6 +76,47 @@ impl<L: Lane> NextEventLanes<L> {
         let f_l = LaneVec3::new(f.x * s.radiance.x, f.y * s.radiance.y, f.z * s.radiance.z);
         f_l * cos * w / s.pdf
     }
+}
+
+/// A sphere light as next-event estimation aims at it, per lane: its centre, radius and
+/// radiance, and the probability that the vertex chose it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct AimedSphereLanes<L: Lane> {
+    pub center: LaneVec3<L>,
+    pub radius: L,
+    pub radiance: LaneVec3<L>,
+    pub pmf: L,
+}
+
+/// Next-event estimation at `vertex` toward `sphere` with the numbers `u`, per lane, as
+/// [`crate::strategy::Lighting::next_event`] makes it: the light's sample and the tests
+/// `Light::sample_drawn` puts it to, the estimate, and the shadow ray's aim. Where it
+/// brings anything, the aim, and what it brings if the shadow ray is free. The one
+/// definition for a wave's estimates in lanes (`SphereNextEvents`, the lane wave's
+/// `Shade`).
+#[inline(always)]
+pub(crate) fn sphere_next_event_lanes<L: Lane>(
+    vertex: &DiffuseLanes<L>,
+    sphere: &AimedSphereLanes<L>,
+    u: [L; 2],
+) -> (L::Mask, ShadowAim<L>, LaneVec3<L>) {
+    let s = sample_sphere_light_lanes(vertex.p, sphere.center, sphere.radius, u);
+    let sampled = L::and(
+        s.valid,
+        L::and(
+            sphere_emits_along_lanes(s.normal, s.wi),
+            usable_pdf_lanes(s.pdf),
+        ),
+    );
+    let sample = LightSampleLanes {
+        wi: s.wi,
+        distance: s.distance,
+        pdf: s.pdf * sphere.pmf,
+        radiance: sphere.radiance,
+    };
+    let e = NextEventLanes::new(vertex, &sample);
+    let aim = ShadowAim::new(vertex.p, vertex.origin, sample.wi, sample.distance);
+    (L::and(sampled, e.weighs), aim, e.contribution(&sample))
 }
 
 /// Where `x` is 0 (either sign): no float lies between 0 and the least subnormal.

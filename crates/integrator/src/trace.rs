@@ -271,24 +271,40 @@ impl LaneKernel for LightTests<'_> {
             let from = LaneVec3::new(row(0), row(1), row(2));
             let dir = LaneVec3::new(row(3), row(4), row(5));
             let t_max = row(6);
-            let (mut best_t, mut best) = (L::splat(0.0), L::splat(-1.0));
-            let mut found = L::splat(0.0).gt(L::splat(0.0));
-            for (i, light) in self.lights.iter().enumerate() {
-                let (t, meets) = light.intersect_lanes(from, dir);
-                let nearer = L::and(
-                    L::and(meets, t_max.gt(t)),
-                    L::not(L::and(found, L::not(best_t.gt(t)))),
-                );
-                best_t = L::select(nearer, t, best_t);
-                best = L::select(nearer, L::splat(i as f32), best);
-                found = L::or(found, nearer);
-            }
+            let (best_t, best, _) = nearest_light_lanes(self.lights, from, dir, t_max);
             best_t.store(&mut ts[..lanes]);
             best.store(&mut lights[..lanes]);
             self.hits
                 .extend((0..rays.len()).map(|lane| (ts[lane], lights[lane])));
         }
     }
+}
+
+/// The nearest of `lights` each lane's ray meets from `from` along `dir` before `t_max`:
+/// its `t`, its index (-1 for none) and the lanes that meet one, the lights tested in
+/// order and the first of equals kept, each as [`PreparedScene::intersect_lights`] finds it
+/// (each light's test is written once over lanes). The one definition for [`LightTests`]
+/// and the lane wave's path rays.
+#[inline(always)]
+pub(crate) fn nearest_light_lanes<L: Lane>(
+    lights: &[Light],
+    from: LaneVec3<L>,
+    dir: LaneVec3<L>,
+    t_max: L,
+) -> (L, L, L::Mask) {
+    let (mut best_t, mut best) = (L::splat(0.0), L::splat(-1.0));
+    let mut found = L::splat(0.0).gt(L::splat(0.0));
+    for (i, light) in lights.iter().enumerate() {
+        let (t, meets) = light.intersect_lanes(from, dir);
+        let nearer = L::and(
+            L::and(meets, t_max.gt(t)),
+            L::not(L::and(found, L::not(best_t.gt(t)))),
+        );
+        best_t = L::select(nearer, t, best_t);
+        best = L::select(nearer, L::splat(i as f32), best);
+        found = L::or(found, nearer);
+    }
+    (best_t, best, found)
 }
 
 impl PreparedScene {

@@ -4,17 +4,17 @@
 
 use glam::Vec3;
 use lueur_materials::CosineScatterLanes;
-use lueur_sampling::{sample_cosine_hemisphere_lanes, sample_sphere_light_lanes};
-use lueur_scene::{Light, sphere_emits_along_lanes, usable_pdf_lanes};
+use lueur_sampling::sample_cosine_hemisphere_lanes;
+use lueur_scene::Light;
 use lueur_sdf_math::{
     GroupRays, HIT_ULPS, Lane, LaneKernel, LaneVec3, TraceParams, position_rounding_lanes,
 };
 
 use super::rows::{self, Block, LANES, ld, ld_mask, ld3, select3, st, st_mask, st3};
 use crate::geometry::Geometry;
-use crate::next_event::{DiffuseLanes, LightSampleLanes, NextEventLanes, all_zero};
-use crate::path::roulette_lanes;
-use crate::surface::ShadowAim;
+use crate::next_event::{AimedSphereLanes, DiffuseLanes, all_zero, sphere_next_event_lanes};
+use crate::roulette::roulette_lanes;
+use crate::trace::nearest_light_lanes;
 
 /// [`TraceParams::resolving`] per lane: the hit thresholds of `params` raised to what
 /// `f32` resolves at each origin.
@@ -24,6 +24,13 @@ fn resolving<V: Lane>(eps_abs: V, eps_rel: V, origin: LaneVec3<V>) -> (V, V) {
         eps_abs.max(V::splat(HIT_ULPS) * position_rounding_lanes(origin)),
         eps_rel.max(V::splat(HIT_ULPS * f32::EPSILON)),
     )
+}
+
+/// The lanes whose next-event estimate found a shadow ray to trace (`rows::NEE` 1).
+#[inline(always)]
+fn shadow_ray_found<V: Lane>(b: &Block, at: usize) -> V::Mask {
+    let state = ld::<V>(b, rows::NEE, at);
+    V::and(state.gt(V::splat(0.5)), state.lt(V::splat(1.5)))
 }
 
 /// `a` where `first`, else `b`.
@@ -76,18 +83,7 @@ impl LaneKernel for PathRays<'_> {
                 );
                 let first = ld::<V>(b, rows::DEPTH, at).lt(V::splat(0.5));
                 let t_max = pick::<V>(first, c.t_max, s.t_max);
-                let (mut best_t, mut best) = (V::splat(0.0), V::splat(-1.0));
-                let mut found = V::splat(0.0).gt(V::splat(0.0));
-                for (i, light) in lights.iter().enumerate() {
-                    let (t, meets) = light.intersect_lanes(from, d);
-                    let nearer = V::and(
-                        V::and(meets, t_max.gt(t)),
-                        V::not(V::and(found, V::not(best_t.gt(t)))),
-                    );
-                    best_t = V::select(nearer, t, best_t);
-                    best = V::select(nearer, V::splat(i as f32), best);
-                    found = V::or(found, nearer);
-                }
+                let (best_t, best, found) = nearest_light_lanes(lights, from, d, t_max);
                 let (eps_abs, eps_rel) = resolving(
                     pick::<V>(first, c.eps_abs, s.eps_abs),
                     pick::<V>(first, c.eps_rel, s.eps_rel),
@@ -170,28 +166,14 @@ impl LaneKernel for Shade<'_> {
                     ld::<V>(b, rows::U_EMITTER, at),
                     ld::<V>(b, rows::U_EMITTER + 1, at),
                 ];
-                let s = sample_sphere_light_lanes(
-                    p,
-                    LaneVec3::splat(sphere.center),
-                    V::splat(sphere.radius),
-                    u,
-                );
-                let sampled = V::and(
-                    s.valid,
-                    V::and(
-                        sphere_emits_along_lanes(s.normal, s.wi),
-                        usable_pdf_lanes(s.pdf),
-                    ),
-                );
-                let sample = LightSampleLanes {
-                    wi: s.wi,
-                    distance: s.distance,
-                    pdf: s.pdf * V::splat(sphere.pmf),
+                let sphere = AimedSphereLanes {
+                    center: LaneVec3::splat(sphere.center),
+                    radius: V::splat(sphere.radius),
                     radiance: LaneVec3::splat(sphere.radiance),
+                    pmf: V::splat(sphere.pmf),
                 };
-                let e = NextEventLanes::new(&vertex, &sample);
-                let aim = ShadowAim::new(p, origin, sample.wi, sample.distance);
-                let found = V::and(diffuse, V::and(sampled, e.weighs));
+                let (found, aim, contribution) = sphere_next_event_lanes(&vertex, &sphere, u);
+                let found = V::and(diffuse, found);
                 let state = V::select(
                     V::and(found, aim.at_point),
                     V::splat(1.0),
@@ -200,7 +182,7 @@ impl LaneKernel for Shade<'_> {
                 st(state, b, rows::NEE, at);
                 st3(aim.dir, b, rows::SD, at);
                 st(aim.distance, b, rows::SDIST, at);
-                st3(e.contribution(&sample), b, rows::C, at);
+                st3(contribution, b, rows::C, at);
 
                 let local = sample_cosine_hemisphere_lanes([
                     ld::<V>(b, rows::U_BSDF, at),
@@ -246,8 +228,7 @@ impl LaneKernel for ShadowRays<'_> {
         } = self;
         for b in blocks.iter_mut() {
             for at in (0..LANES).step_by(V::LANES) {
-                let state = ld::<V>(b, rows::NEE, at);
-                let found = V::and(state.gt(V::splat(0.5)), state.lt(V::splat(1.5)));
+                let found = shadow_ray_found::<V>(b, at);
                 if !V::any(found) {
                     st_mask::<V>(found, b, rows::MARCHED, at);
                     continue;
@@ -308,9 +289,8 @@ impl LaneKernel for Scatter<'_> {
                     continue;
                 }
                 let beta = ld3::<V>(b, rows::BETA, at);
-                let state = ld::<V>(b, rows::NEE, at);
                 let brings = V::and(
-                    V::and(state.gt(V::splat(0.5)), state.lt(V::splat(1.5))),
+                    shadow_ray_found::<V>(b, at),
                     ld_mask::<V>(b, rows::FREE, at),
                 );
                 let radiance = ld3::<V>(b, rows::L, at);

@@ -35,9 +35,8 @@ use self::kernels::{AimedSphere, PathRays, Scatter, Shade, ShadowRays};
 use self::rows::{Block, LANES, get3, set3};
 use crate::Hit;
 use crate::PreparedScene;
-use crate::path::{
-    ENDED_PER_SLOT, Estimator, Previous, SampleId, emission_found, roulette_applies,
-};
+use crate::path::{ENDED_PER_SLOT, Estimator, Previous, SampleId, emission_found};
+use crate::roulette::roulette_applies;
 use crate::stages::{Stage, StageClock, StageTimes};
 use crate::strategy::{EmissionWeight, Lighting, Vertex, VertexReads, VertexSample};
 use crate::surface::{SurfaceHit, SurfacePoint, SurfaceScratch};
