@@ -215,7 +215,7 @@ struct ShadowQueue {
 }
 
 /// The material of the object a path met.
-fn material_at(scene: &PreparedScene, on_surface: SurfaceHit) -> Material {
+pub(crate) fn material_at(scene: &PreparedScene, on_surface: SurfaceHit) -> Material {
     scene.scene().materials[scene.scene().objects[on_surface.object].material]
 }
 

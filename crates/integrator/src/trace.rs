@@ -454,7 +454,7 @@ impl PreparedScene {
     /// The surface a march of `ray` with parameters `params` found, if any. Inlined: its
     /// result, returned through memory, is loaded whole before its stores retire.
     #[inline(always)]
-    fn surface_hit(
+    pub(crate) fn surface_hit(
         &self,
         ray: &Ray,
         p: &TraceParams,

@@ -89,5 +89,5 @@ pub use crate::stream::{
 };
 pub use crate::trace::{
     HIT_ULPS, OVER_RELAXATION, TraceOutcome, TraceParams, position_rounding,
-    position_rounding_lanes, sphere_trace, sphere_trace_relaxed,
+    position_rounding_lanes, resolving_lanes, sphere_trace, sphere_trace_relaxed,
 };

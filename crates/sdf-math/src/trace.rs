@@ -52,12 +52,23 @@ impl TraceParams {
     /// can resolve *along this ray*, whatever else the scene holds.
     #[inline]
     pub fn resolving(self, origin: Vec3) -> TraceParams {
+        let (eps_abs, eps_rel) = resolving_lanes(self.eps_abs, self.eps_rel, origin.into());
         TraceParams {
-            eps_abs: self.eps_abs.max(HIT_ULPS * position_rounding(origin)),
-            eps_rel: self.eps_rel.max(HIT_ULPS * f32::EPSILON),
+            eps_abs,
+            eps_rel,
             ..self
         }
     }
+}
+
+/// [`TraceParams::resolving`]'s thresholds for each lane's ray from `origin`, `eps_abs`
+/// and `eps_rel` raised as it raises them: its one definition.
+#[inline(always)]
+pub fn resolving_lanes<L: Lane>(eps_abs: L, eps_rel: L, origin: LaneVec3<L>) -> (L, L) {
+    (
+        eps_abs.max(L::splat(HIT_ULPS) * position_rounding_lanes(origin)),
+        eps_rel.max(L::splat(HIT_ULPS * f32::EPSILON)),
+    )
 }
 
 impl Default for TraceParams {

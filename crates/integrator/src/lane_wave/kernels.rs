@@ -2,29 +2,16 @@
 //! each lane's values are the bits the scalar wave computes for its path alone (every
 //! formula here is a definition the scalar wave runs at `f32`).
 
-use glam::Vec3;
 use lueur_materials::CosineScatterLanes;
 use lueur_sampling::sample_cosine_hemisphere_lanes;
 use lueur_scene::Light;
-use lueur_sdf_math::{
-    GroupRays, HIT_ULPS, Lane, LaneKernel, LaneVec3, TraceParams, position_rounding_lanes,
-};
+use lueur_sdf_math::{GroupRays, Lane, LaneKernel, LaneVec3, TraceParams, resolving_lanes};
 
 use super::rows::{self, Block, LANES, ld, ld_mask, ld3, select3, st, st_mask, st3};
 use crate::geometry::Geometry;
 use crate::next_event::{AimedSphereLanes, DiffuseLanes, all_zero, sphere_next_event_lanes};
 use crate::roulette::roulette_lanes;
 use crate::trace::nearest_light_lanes;
-
-/// [`TraceParams::resolving`] per lane: the hit thresholds of `params` raised to what
-/// `f32` resolves at each origin.
-#[inline(always)]
-fn resolving<V: Lane>(eps_abs: V, eps_rel: V, origin: LaneVec3<V>) -> (V, V) {
-    (
-        eps_abs.max(V::splat(HIT_ULPS) * position_rounding_lanes(origin)),
-        eps_rel.max(V::splat(HIT_ULPS * f32::EPSILON)),
-    )
-}
 
 /// The lanes whose next-event estimate found a shadow ray to trace (`rows::NEE` 1).
 #[inline(always)]
@@ -84,7 +71,7 @@ impl LaneKernel for PathRays<'_> {
                 let first = ld::<V>(b, rows::DEPTH, at).lt(V::splat(0.5));
                 let t_max = pick::<V>(first, c.t_max, s.t_max);
                 let (best_t, best, found) = nearest_light_lanes(lights, from, d, t_max);
-                let (eps_abs, eps_rel) = resolving(
+                let (eps_abs, eps_rel) = resolving_lanes(
                     pick::<V>(first, c.eps_abs, s.eps_abs),
                     pick::<V>(first, c.eps_rel, s.eps_rel),
                     o,
@@ -105,7 +92,8 @@ impl LaneKernel for PathRays<'_> {
                 st_mask::<V>(ends.gave_up(), b, rows::GAVE_UP, at);
                 st(ends.steps(), b, rows::STEPS, at);
                 st(nearest, b, rows::NEAR, at);
-                st(eps_abs.max(eps_rel * ends.t()), b, rows::SHELL, at);
+                st(eps_abs, b, rows::EPS_ABS, at);
+                st(eps_rel, b, rows::EPS_REL, at);
                 st(best, b, rows::LIGHT, at);
                 st(best_t, b, rows::LIGHT_T, at);
             }
@@ -113,22 +101,13 @@ impl LaneKernel for PathRays<'_> {
     }
 }
 
-/// The one sphere light next-event estimation aims at: its centre, radius, radiance, and
-/// the probability of its choice.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct AimedSphere {
-    pub center: Vec3,
-    pub radius: f32,
-    pub radiance: Vec3,
-    pub pmf: f32,
-}
-
 /// At every diffuse vertex (`rows::DIFFUSE`): next-event estimation toward the sphere light
-/// (the sample, the tests `Light::sample_drawn` puts it to, the estimate and the shadow
-/// ray's aim, as `SphereNextEvents` makes them), and the BSDF's sample by the cosine
-/// (`CosineScatterLanes`, as `CosineScatters` draws it for `mis`).
+/// (`sphere_next_event_lanes`, as `SphereNextEvents` makes it), and the BSDF's sample by
+/// the cosine (`CosineScatterLanes`, as `CosineScatters` draws it for `mis`). A vector
+/// with no diffuse vertex only clears its estimates; the other lanes' scatter rows are
+/// the mirrors' to write, after the kernel.
 pub(super) struct Shade<'a> {
-    pub sphere: AimedSphere,
+    pub sphere: AimedSphereLanes<f32>,
     pub blocks: &'a mut [Block],
 }
 
@@ -167,9 +146,9 @@ impl LaneKernel for Shade<'_> {
                     ld::<V>(b, rows::U_EMITTER + 1, at),
                 ];
                 let sphere = AimedSphereLanes {
-                    center: LaneVec3::splat(sphere.center),
+                    center: LaneVec3::splat(sphere.center.into()),
                     radius: V::splat(sphere.radius),
-                    radiance: LaneVec3::splat(sphere.radiance),
+                    radiance: LaneVec3::splat(sphere.radiance.into()),
                     pmf: V::splat(sphere.pmf),
                 };
                 let (found, aim, contribution) = sphere_next_event_lanes(&vertex, &sphere, u);
@@ -188,20 +167,12 @@ impl LaneKernel for Shade<'_> {
                     ld::<V>(b, rows::U_BSDF, at),
                     ld::<V>(b, rows::U_BSDF + 1, at),
                 ]);
+                // A mirror's lanes are written over after the kernel.
                 let cs = CosineScatterLanes::new(albedo, wo, n, local);
-                // A mirror's lanes keep the scatter written for them.
-                let wi = select3(diffuse, cs.wi, ld3::<V>(b, rows::WI, at));
-                let weight = select3(diffuse, cs.weight, ld3::<V>(b, rows::WEIGHT, at));
-                let pdf = V::select(diffuse, cs.pdf, ld::<V>(b, rows::WPDF, at));
-                let valid = V::select(
-                    diffuse,
-                    V::select(cs.valid, V::splat(1.0), V::splat(0.0)),
-                    ld::<V>(b, rows::WVALID, at),
-                );
-                st3(wi, b, rows::WI, at);
-                st3(weight, b, rows::WEIGHT, at);
-                st(pdf, b, rows::WPDF, at);
-                st(valid, b, rows::WVALID, at);
+                st3(cs.wi, b, rows::WI, at);
+                st3(cs.weight, b, rows::WEIGHT, at);
+                st(cs.pdf, b, rows::WPDF, at);
+                st_mask::<V>(cs.valid, b, rows::WVALID, at);
             }
         }
     }
@@ -235,7 +206,7 @@ impl LaneKernel for ShadowRays<'_> {
                 }
                 let origin = ld3::<V>(b, rows::ORIGIN, at);
                 let (eps_abs, eps_rel) =
-                    resolving(V::splat(params.eps_abs), V::splat(params.eps_rel), origin);
+                    resolving_lanes(V::splat(params.eps_abs), V::splat(params.eps_rel), origin);
                 // Short of the light's surface, so that its own geometry (for lights that are
                 // objects too) does not occlude it.
                 let distance = ld::<V>(b, rows::SDIST, at);
@@ -326,61 +297,15 @@ impl LaneKernel for Scatter<'_> {
                 let wi = ld3::<V>(b, rows::WI, at);
                 // `Ray::new`'s direction: `wi` times the reciprocal of its length.
                 let dir = wi * (V::splat(1.0) / wi.length());
-                st3(select3(next, survivor, beta), b, rows::BETA, at);
-                st(
-                    V::select(next, depth, ld::<V>(b, rows::DEPTH, at)),
-                    b,
-                    rows::DEPTH,
-                    at,
-                );
-                st3(
-                    select3(
-                        next,
-                        ld3::<V>(b, rows::ORIGIN, at),
-                        ld3::<V>(b, rows::O, at),
-                    ),
-                    b,
-                    rows::O,
-                    at,
-                );
-                st3(select3(next, dir, ld3::<V>(b, rows::D, at)), b, rows::D, at);
-                st3(
-                    select3(next, ld3::<V>(b, rows::P, at), ld3::<V>(b, rows::FROM, at)),
-                    b,
-                    rows::FROM,
-                    at,
-                );
-                st3(
-                    select3(
-                        next,
-                        ld3::<V>(b, rows::N, at),
-                        ld3::<V>(b, rows::FROM_N, at),
-                    ),
-                    b,
-                    rows::FROM_N,
-                    at,
-                );
-                let diffuse = ld_mask::<V>(b, rows::DIFFUSE, at);
-                st(
-                    V::select(
-                        next,
-                        V::select(diffuse, V::splat(1.0), V::splat(0.0)),
-                        ld::<V>(b, rows::EMIT_MIS, at),
-                    ),
-                    b,
-                    rows::EMIT_MIS,
-                    at,
-                );
-                st(
-                    V::select(
-                        next,
-                        ld::<V>(b, rows::WPDF, at),
-                        ld::<V>(b, rows::EMIT_PDF, at),
-                    ),
-                    b,
-                    rows::EMIT_PDF,
-                    at,
-                );
+                // A lane that does not go on ends, and its next path overwrites these rows.
+                st3(survivor, b, rows::BETA, at);
+                st(depth, b, rows::DEPTH, at);
+                st3(ld3::<V>(b, rows::ORIGIN, at), b, rows::O, at);
+                st3(dir, b, rows::D, at);
+                st3(ld3::<V>(b, rows::P, at), b, rows::FROM, at);
+                st3(ld3::<V>(b, rows::N, at), b, rows::FROM_N, at);
+                st(ld::<V>(b, rows::DIFFUSE, at), b, rows::EMIT_MIS, at);
+                st(ld::<V>(b, rows::WPDF, at), b, rows::EMIT_PDF, at);
             }
         }
     }

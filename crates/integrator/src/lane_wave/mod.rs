@@ -25,20 +25,20 @@ mod rows;
 use std::collections::VecDeque;
 use std::time::Instant;
 
-use glam::Vec3;
-use lueur_materials::{HemisphereSampling, Material};
+use glam::{Vec2, Vec3};
+use lueur_materials::Material;
 use lueur_sampling::Sampler;
 use lueur_scene::{Light, Marching, Strategy};
-use lueur_sdf_math::{DistanceField, Ray, TraceOutcome};
+use lueur_sdf_math::{Ray, TraceOutcome, TraceParams};
 
-use self::kernels::{AimedSphere, PathRays, Scatter, Shade, ShadowRays};
+use self::kernels::{PathRays, Scatter, Shade, ShadowRays};
 use self::rows::{Block, LANES, get3, set3};
 use crate::Hit;
-use crate::PreparedScene;
-use crate::path::{ENDED_PER_SLOT, Estimator, Previous, SampleId, emission_found};
+use crate::next_event::AimedSphereLanes;
+use crate::path::{ENDED_PER_SLOT, Estimator, Previous, SampleId, emission_found, material_at};
 use crate::roulette::roulette_applies;
 use crate::stages::{Stage, StageClock, StageTimes};
-use crate::strategy::{EmissionWeight, Lighting, Vertex, VertexReads, VertexSample};
+use crate::strategy::{self, EmissionWeight, Lighting, Vertex, VertexReads, VertexSample};
 use crate::surface::{SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::RayCounters;
 
@@ -46,7 +46,7 @@ use crate::trace::RayCounters;
 /// aims at.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LaneWave {
-    sphere: AimedSphere,
+    sphere: AimedSphereLanes<f32>,
 }
 
 impl LaneWave {
@@ -81,10 +81,10 @@ impl LaneWave {
         }
         let chosen = lighting.emitters.chosen_sphere(0.0)?;
         Some(LaneWave {
-            sphere: AimedSphere {
-                center: chosen.sphere.center,
+            sphere: AimedSphereLanes {
+                center: chosen.sphere.center.into(),
                 radius: chosen.sphere.radius,
-                radiance: chosen.sphere.radiance,
+                radiance: chosen.sphere.radiance.into(),
                 pmf: chosen.pmf,
             },
         })
@@ -194,17 +194,34 @@ pub(crate) fn radiance_lanes(
             let b = &mut s.blocks[lane / LANES];
             let l = lane % LANES;
             b[rows::SHADE][l] = 0.0;
-            count_path_ray(b, l, counters);
+            let outcome = path_outcome(b, l);
+            counters.path_ray(b[rows::DEPTH][l] == 0.0).record(&outcome);
             let ray = Ray {
                 origin: get3(b, rows::O, l),
                 dir: get3(b, rows::D, l),
             };
-            let Some(on_surface) = surface_hit(scene, b, l, &ray) else {
-                let light = b[rows::LIGHT][l];
-                let hit = (light >= 0.0).then(|| Hit::Light {
-                    t: b[rows::LIGHT_T][l],
-                    light: light as usize,
+            // Marched with these thresholds; the other parameters do not enter the hit.
+            let params = TraceParams {
+                eps_abs: b[rows::EPS_ABS][l],
+                eps_rel: b[rows::EPS_REL][l],
+                ..march.secondary
+            };
+            let light = b[rows::LIGHT][l];
+            let hit = scene
+                .surface_hit(
+                    &ray,
+                    &params,
+                    false,
+                    outcome,
+                    Some(b[rows::NEAR][l] as usize),
+                )
+                .or_else(|| {
+                    (light >= 0.0).then(|| Hit::Light {
+                        t: b[rows::LIGHT_T][l],
+                        light: light as usize,
+                    })
                 });
+            let Some(on_surface) = SurfaceHit::of(hit) else {
                 let previous = Previous {
                     p: get3(b, rows::FROM, l),
                     n: get3(b, rows::FROM_N, l),
@@ -229,7 +246,7 @@ pub(crate) fn radiance_lanes(
                 b[rows::ENDED][l] = 1.0;
                 continue;
             }
-            let material = material_at(scene, on_surface.object);
+            let material = material_at(scene, on_surface);
             let (albedo, diffuse) = match material {
                 Material::Lambertian { albedo } => (albedo, true),
                 Material::Mirror { reflectance } => (reflectance, false),
@@ -273,22 +290,6 @@ pub(crate) fn radiance_lanes(
             set3(b, rows::P, l, surface.p);
             set3(b, rows::N, l, surface.n);
             set3(b, rows::ORIGIN, l, surface.origin);
-            if b[rows::DIFFUSE][l] > 0.0 {
-                continue;
-            }
-            // A mirror's bounce, as `strategy::mirror` makes it.
-            let material = Material::Mirror {
-                reflectance: get3(b, rows::ALBEDO, l),
-            };
-            let wo = -get3(b, rows::D, l);
-            let bounce =
-                material.sample(wo, surface.n, glam::Vec2::ZERO, HemisphereSampling::Cosine);
-            b[rows::WVALID][l] = if bounce.is_some() { 1.0 } else { 0.0 };
-            if let Some(bounce) = bounce {
-                set3(b, rows::WI, l, bounce.wi);
-                set3(b, rows::WEIGHT, l, bounce.weight(surface.n));
-                b[rows::WPDF][l] = 0.0;
-            }
         }
         clock.lap(Stage::ShadingPoints);
 
@@ -297,19 +298,31 @@ pub(crate) fn radiance_lanes(
             sphere: wave.sphere,
             blocks: &mut s.blocks,
         });
-        // An estimate whose shadow ray does not aim at its point, made again alone.
+        // A mirror's bounce (`strategy::mirror`), and an estimate whose shadow ray does not
+        // aim at its point, made again alone.
         for (k, &lane) in s.lanes.iter().enumerate() {
             let (b, l) = (&mut s.blocks[lane / LANES], lane % LANES);
-            if b[rows::NEE][l] != 2.0 {
+            let diffuse = b[rows::DIFFUSE][l] > 0.0;
+            if diffuse && b[rows::NEE][l] != 2.0 {
                 continue;
             }
             let vertex = Vertex {
                 at: &s.surfaces[k],
                 wo: -get3(b, rows::D, l),
-                material: material_at(scene, s.hits[k].1.object),
+                material: material_at(scene, s.hits[k].1),
             };
+            if !diffuse {
+                let bounce = strategy::mirror(&vertex, Vec2::ZERO);
+                b[rows::WVALID][l] = if bounce.is_some() { 1.0 } else { 0.0 };
+                if let Some(bounce) = bounce {
+                    set3(b, rows::WI, l, bounce.wi);
+                    set3(b, rows::WEIGHT, l, bounce.weight);
+                    b[rows::WPDF][l] = bounce.pdf;
+                }
+                continue;
+            }
             let mut u = VertexSample::UNSET;
-            u.emitter = glam::Vec2::new(b[rows::U_EMITTER][l], b[rows::U_EMITTER + 1][l]);
+            u.emitter = Vec2::new(b[rows::U_EMITTER][l], b[rows::U_EMITTER + 1][l]);
             match lighting.next_event(&vertex, &u, None) {
                 Some((ray, contribution)) => {
                     b[rows::NEE][l] = 1.0;
@@ -381,45 +394,16 @@ fn start(b: &mut Block, l: usize, ray: Ray) {
     b[rows::ALIVE][l] = 1.0;
 }
 
-/// The surface lane `l`'s path ray found, as `PreparedScene::surface_hit` takes it from the
-/// march: a hit, or a ray that gave up at the step cap, where it stopped, its shell
-/// widened to the field there.
-fn surface_hit(scene: &PreparedScene, b: &Block, l: usize, ray: &Ray) -> Option<SurfaceHit> {
-    let (t, object) = (b[rows::T][l], b[rows::NEAR][l] as usize);
-    let mut epsilon = b[rows::SHELL][l];
-    if b[rows::HIT][l] == 0.0 {
-        if b[rows::GAVE_UP][l] == 0.0 || b[rows::STEPS][l] == 0.0 {
-            return None;
-        }
-        let f = scene.prepared(object).distance(ray.at(t)).abs();
-        if f.is_finite() {
-            epsilon = epsilon.max(f);
-        }
-    }
-    Some(SurfaceHit {
-        t,
-        object,
-        epsilon,
-        inside: false,
-    })
-}
-
-fn material_at(scene: &PreparedScene, object: usize) -> Material {
-    let model = scene.scene();
-    model.materials[model.objects[object].material]
-}
-
-/// Lane `l`'s path ray's march, in its kind's counters.
-fn count_path_ray(b: &Block, l: usize, counters: &mut RayCounters) {
+/// How lane `l`'s path ray's march ended.
+fn path_outcome(b: &Block, l: usize) -> TraceOutcome {
     let (t, steps) = (b[rows::T][l], b[rows::STEPS][l] as u32);
-    let outcome = if b[rows::HIT][l] > 0.0 {
+    if b[rows::HIT][l] > 0.0 {
         TraceOutcome::Hit { t, steps }
     } else if b[rows::GAVE_UP][l] > 0.0 {
         TraceOutcome::GaveUp { t, steps }
     } else {
         TraceOutcome::Miss { steps }
-    };
-    counters.path_ray(b[rows::DEPTH][l] == 0.0).record(&outcome);
+    }
 }
 
 /// Each shadow ray marched, in the shadow rays' counters (their `t` is not kept).

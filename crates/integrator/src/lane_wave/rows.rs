@@ -30,14 +30,15 @@ pub(super) const EMIT_PDF: usize = 20;
 pub(super) const ALIVE: usize = 21;
 
 /// What the path ray found: the march's end `T`, whether it hit (`HIT`) or gave up
-/// (`GAVE_UP`), its `STEPS`, the object `NEAR` where it ended, the hit threshold there
-/// (`SHELL`); the nearest light it meets (`LIGHT`, its index or -1) at `LIGHT_T`.
+/// (`GAVE_UP`), its `STEPS`, the object `NEAR` where it ended, the hit thresholds it was
+/// marched with (`EPS_ABS`, `EPS_REL`); the nearest light it meets (`LIGHT`, its index or
+/// -1) at `LIGHT_T`.
 pub(super) const T: usize = 22;
 pub(super) const HIT: usize = 23;
 pub(super) const GAVE_UP: usize = 24;
 pub(super) const STEPS: usize = 25;
 pub(super) const NEAR: usize = 26;
-pub(super) const SHELL: usize = 27;
+pub(super) const EPS_ABS: usize = 27;
 pub(super) const LIGHT: usize = 28;
 pub(super) const LIGHT_T: usize = 29;
 
@@ -73,9 +74,10 @@ pub(super) const WEIGHT: usize = 64;
 pub(super) const WPDF: usize = 67;
 pub(super) const WVALID: usize = 68;
 pub(super) const ENDED: usize = 69;
+pub(super) const EPS_REL: usize = 70;
 
 /// Rows per block.
-pub(super) const COUNT: usize = 70;
+pub(super) const COUNT: usize = 71;
 
 /// A block in its first state: no path, every value finite.
 pub(super) const EMPTY: Block = [[0.0; LANES]; COUNT];
