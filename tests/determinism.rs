@@ -393,6 +393,13 @@ fn the_lane_wave_gives_the_image_of_the_wave_of_records() {
     let mut first = base.clone();
     first.max_depth = 1;
     cases.push(("cornell, one vertex", cornell.scene.clone(), first));
+    let mut independent = base.clone();
+    independent.sampler = SamplerKind::Independent;
+    cases.push((
+        "cornell, independent numbers",
+        cornell.scene.clone(),
+        independent,
+    ));
     let mut roulette = base.clone();
     (roulette.roulette_depth, roulette.max_depth) = (0, 64);
     roulette.sampler = SamplerKind::Independent;

@@ -48,6 +48,12 @@ pub(crate) struct VertexSample {
 }
 
 impl VertexSample {
+    /// Where `emitter`, `bsdf` and `roulette` lie among a vertex's dimensions, in the
+    /// order [`VertexSample::draw`] takes them (`emitter_choice` at 0, `mixture` at 3).
+    pub const EMITTER_DIM: usize = 1;
+    pub const BSDF_DIM: usize = 4;
+    pub const ROULETTE_DIM: usize = 6;
+
     /// Every number 0: a slot for [`VertexSample::draw`] to fill.
     pub const UNSET: VertexSample = VertexSample {
         emitter_choice: 0.0,
@@ -701,6 +707,30 @@ mod tests {
     use lueur_sampling::SamplerKind;
     use lueur_scene::{Camera, Light, QuadSampling, Scene};
     use lueur_stats::DirectionBins;
+
+    /// `draw` takes each number at the dimension `VertexSample::*_DIM` names, the lane
+    /// wave's kernel reading them from the independent kind's stream.
+    #[test]
+    fn a_vertex_s_numbers_lie_at_their_dimensions() {
+        let mut sampler = Sampler::for_render(SamplerKind::Independent, 3, [16, 16], 8, 1);
+        let (pixel, index, depth) = ([5, 9], 6, 2);
+        let mut u = VertexSample::UNSET;
+        let reads = VertexReads::of(Strategy::Mixture, true, true, true);
+        u.draw(&mut sampler, pixel, index, depth, reads);
+        let mut dims = [0.0f32; DIMS_PER_VERTEX as usize];
+        sampler.start_pixel_sample(pixel, index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
+        for d in &mut dims {
+            *d = sampler.next_1d();
+        }
+        let at = |k: usize| dims[k].to_bits();
+        assert_eq!(u.emitter.x.to_bits(), at(VertexSample::EMITTER_DIM));
+        assert_eq!(u.emitter.y.to_bits(), at(VertexSample::EMITTER_DIM + 1));
+        assert_eq!(u.bsdf.x.to_bits(), at(VertexSample::BSDF_DIM));
+        assert_eq!(u.bsdf.y.to_bits(), at(VertexSample::BSDF_DIM + 1));
+        assert_eq!(u.roulette.to_bits(), at(VertexSample::ROULETTE_DIM));
+        assert_eq!(u.emitter_choice.to_bits(), at(0));
+        assert_eq!(u.mixture.to_bits(), at(3));
+    }
 
     const N_SAMPLES: usize = 200_000;
     const N_Z: usize = 16;

@@ -76,6 +76,7 @@ mod frame;
 mod light;
 mod math;
 mod mis;
+mod pcg_lanes;
 mod quad_light;
 mod sampler;
 mod sampler_kind;
@@ -89,6 +90,7 @@ pub use frame::{Frame, FrameLanes};
 pub use light::{DirectionSample, DirectionSampleLanes};
 pub use math::ONE_MINUS_EPSILON;
 pub use mis::{balance_heuristic, power_heuristic, power_heuristic_lanes};
+pub use pcg_lanes::PcgLanes;
 pub use quad_light::{
     RECTANGLE_LANES, RectangleFrame, SphericalRectangle, SphericalRectangles, polygon_irradiance,
     quad_area_pdf, quad_solid_angle_pdf, sample_quad_area, sample_quad_solid_angle,

@@ -84,7 +84,7 @@ pub struct Sampler {
 }
 
 /// The multiplier of the LCG under `rand_pcg`'s `Pcg32` (PCG's 64-bit default).
-const PCG_MULTIPLIER: u64 = 6_364_136_223_846_793_005;
+pub(crate) const PCG_MULTIPLIER: u64 = 6_364_136_223_846_793_005;
 
 /// `(a, g)` such that `delta` steps of the LCG `s -> PCG_MULTIPLIER s + inc` take `s`
 /// to `a s + g inc` (mod 2^64), whatever `inc`: Brown's jump ("Random Number Generation
@@ -117,8 +117,8 @@ fn pixel_key(pixel: [u32; 2]) -> u64 {
 }
 
 /// A 32-bit binary fraction as an `f32` in `[0, 1)`: its top 24 bits.
-#[inline]
-fn fraction_to_f32(x: u32) -> f32 {
+#[inline(always)]
+pub(crate) fn fraction_to_f32(x: u32) -> f32 {
     (x >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
@@ -283,6 +283,16 @@ impl Sampler {
         self.seed
     }
 
+    /// For [`SamplerKind::Independent`], the generator where the sampler stands, as
+    /// [`PcgLanes`](crate::PcgLanes) keeps a lane's: its state and increment. Its outputs
+    /// in order are the current pixel sample's dimensions from the one the sampler
+    /// stands at (each position of the stream is a step of the generator, so stepping it
+    /// over dimensions no one reads reaches a later dimension). `None` for the other kinds.
+    pub fn independent_generator(&self) -> Option<(u64, u64)> {
+        (self.kind == SamplerKind::Independent)
+            .then(|| (self.rng.state(), (self.rng.stream() << 1) | 1))
+    }
+
     /// Positions the sampler so that the next value is dimension `dimension`
     /// of sample `sample_index` of `pixel` (pbrt-v4 `StartPixelSample`).
     pub fn start_pixel_sample(&mut self, pixel: [u32; 2], sample_index: u32, dimension: u32) {
@@ -365,7 +375,7 @@ impl Sampler {
     pub fn next_1d(&mut self) -> f32 {
         if self.kind == SamplerKind::Independent {
             self.stream_position = self.stream_position.wrapping_add(1);
-            return (self.rng.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0);
+            return fraction_to_f32(self.rng.next_u32());
         }
         // The default kind inline, the others through `sample_1d`'s table.
         let value = if self.kind == SamplerKind::SobolXor {

@@ -3,7 +3,7 @@
 //! formula here is a definition the scalar wave runs at `f32`).
 
 use lueur_materials::CosineScatterLanes;
-use lueur_sampling::sample_cosine_hemisphere_lanes;
+use lueur_sampling::{PcgLanes, sample_cosine_hemisphere_lanes};
 use lueur_scene::Light;
 use lueur_sdf_math::{GroupRays, Lane, LaneKernel, LaneVec3, TraceParams, resolving_lanes};
 
@@ -11,6 +11,7 @@ use super::rows::{self, Block, LANES, ld, ld_mask, ld3, select3, st, st_mask, st
 use crate::geometry::Geometry;
 use crate::next_event::{AimedSphereLanes, DiffuseLanes, all_zero, sphere_next_event_lanes};
 use crate::roulette::roulette_lanes;
+use crate::strategy::{DIMS_PER_VERTEX, VertexSample};
 use crate::trace::nearest_light_lanes;
 
 /// The lanes whose next-event estimate found a shadow ray to trace (`rows::NEE` 1).
@@ -97,6 +98,39 @@ impl LaneKernel for PathRays<'_> {
                 st(best, b, rows::LIGHT, at);
                 st(best_t, b, rows::LIGHT_T, at);
             }
+        }
+    }
+}
+
+/// The numbers of every vertex shaded this round (`rows::SHADE`), for the independent
+/// kind: each lane's generator stepped over the vertex's dimensions, the numbers taken at
+/// the dimensions `VertexSample::draw` reads them from. Numbers the vertex does not read
+/// are written too (no kernel reads them: a mirror's, or roulette's before it applies),
+/// and the generators stand at the next vertex's first dimension after. Blocks with no
+/// vertex to shade are left as they are.
+pub(super) struct VertexNumbers<'a> {
+    pub blocks: &'a mut [Block],
+    pub generators: &'a mut [PcgLanes<LANES>],
+}
+
+impl LaneKernel for VertexNumbers<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<V: Lane>(self) {
+        for (b, generators) in self.blocks.iter_mut().zip(self.generators.iter_mut()) {
+            if b[rows::SHADE].iter().all(|&shade| shade == 0.0) {
+                continue;
+            }
+            let mut numbers = [[0.0; LANES]; DIMS_PER_VERTEX as usize];
+            for number in &mut numbers {
+                *number = generators.next_1d();
+            }
+            b[rows::U_EMITTER] = numbers[VertexSample::EMITTER_DIM];
+            b[rows::U_EMITTER + 1] = numbers[VertexSample::EMITTER_DIM + 1];
+            b[rows::U_BSDF] = numbers[VertexSample::BSDF_DIM];
+            b[rows::U_BSDF + 1] = numbers[VertexSample::BSDF_DIM + 1];
+            b[rows::U_ROULETTE] = numbers[VertexSample::ROULETTE_DIM];
         }
     }
 }

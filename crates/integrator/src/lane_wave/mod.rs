@@ -27,11 +27,11 @@ use std::time::Instant;
 
 use glam::{Vec2, Vec3};
 use lueur_materials::Material;
-use lueur_sampling::Sampler;
+use lueur_sampling::{PcgLanes, Sampler, SamplerKind};
 use lueur_scene::{Light, Marching, Strategy};
 use lueur_sdf_math::{Ray, TraceOutcome, TraceParams};
 
-use self::kernels::{PathRays, Scatter, Shade, ShadowRays};
+use self::kernels::{PathRays, Scatter, Shade, ShadowRays, VertexNumbers};
 use self::rows::{Block, LANES, get3, set3};
 use crate::Hit;
 use crate::next_event::AimedSphereLanes;
@@ -103,6 +103,8 @@ struct Slot {
 #[derive(Default)]
 pub(crate) struct LaneScratch {
     blocks: Vec<Block>,
+    /// Each block's generators, where the independent kind's numbers are drawn in lanes.
+    generators: Vec<PcgLanes<LANES>>,
     slots: Vec<Option<Slot>>,
     ended: VecDeque<Option<(SampleId, Vec3)>>,
     /// The hits shaded this round, and the lane of each.
@@ -138,6 +140,11 @@ pub(crate) fn radiance_lanes(
     let blocks = width.max(1).div_ceil(LANES);
     s.blocks.clear();
     s.blocks.resize(blocks, rows::EMPTY);
+    // The independent kind's numbers are drawn for a vector of paths at once
+    // (`VertexNumbers`); the other kinds' by each path's sampler.
+    let numbers_in_lanes = settings.sampler == SamplerKind::Independent;
+    s.generators.clear();
+    s.generators.resize(blocks, PcgLanes::UNSET);
     s.slots.clear();
     s.slots.resize_with(blocks * LANES, || None);
     s.ended.clear();
@@ -158,6 +165,9 @@ pub(crate) fn radiance_lanes(
             };
             s.vacant.pop();
             start(&mut s.blocks[lane / LANES], lane % LANES, ray);
+            if let Some(generator) = sampler.independent_generator() {
+                s.generators[lane / LANES].set(lane % LANES, generator);
+            }
             s.slots[lane] = Some(Slot {
                 id,
                 sampler,
@@ -251,6 +261,14 @@ pub(crate) fn radiance_lanes(
                 Material::Lambertian { albedo } => (albedo, true),
                 Material::Mirror { reflectance } => (reflectance, false),
             };
+            b[rows::SHADE][l] = 1.0;
+            b[rows::DIFFUSE][l] = if diffuse { 1.0 } else { 0.0 };
+            set3(b, rows::ALBEDO, l, albedo);
+            s.hits.push((ray, on_surface));
+            s.lanes.push(lane);
+            if numbers_in_lanes {
+                continue;
+            }
             let mut u = VertexSample::UNSET;
             u.draw(
                 &mut slot.sampler,
@@ -264,16 +282,18 @@ pub(crate) fn radiance_lanes(
                     roulette_applies(depth + 1, settings.roulette_depth),
                 ),
             );
-            b[rows::SHADE][l] = 1.0;
-            b[rows::DIFFUSE][l] = if diffuse { 1.0 } else { 0.0 };
-            set3(b, rows::ALBEDO, l, albedo);
             b[rows::U_EMITTER][l] = u.emitter.x;
             b[rows::U_EMITTER + 1][l] = u.emitter.y;
             b[rows::U_BSDF][l] = u.bsdf.x;
             b[rows::U_BSDF + 1][l] = u.bsdf.y;
             b[rows::U_ROULETTE][l] = u.roulette;
-            s.hits.push((ray, on_surface));
-            s.lanes.push(lane);
+        }
+        if numbers_in_lanes {
+            // The level is available: `or_widest` says so.
+            let _ = level.dispatch(VertexNumbers {
+                blocks: &mut s.blocks,
+                generators: &mut s.generators,
+            });
         }
         clock.lap(Stage::VertexNumbers);
 
