@@ -39,7 +39,7 @@ use crate::path::{ENDED_PER_SLOT, Estimator, Previous, SampleId, emission_found,
 use crate::roulette::roulette_applies;
 use crate::stages::{Stage, StageClock, StageTimes};
 use crate::strategy::{self, EmissionWeight, Lighting, Vertex, VertexReads, VertexSample};
-use crate::surface::{SurfaceHit, SurfacePoint, SurfaceScratch};
+use crate::surface::{HitSource, SurfaceHit, SurfacePoint, SurfaceScratch};
 use crate::trace::RayCounters;
 
 /// What the lane wave needs of a scene it models: the sphere light next-event estimation
@@ -107,10 +107,8 @@ pub(crate) struct LaneScratch {
     generators: Vec<PcgLanes<LANES>>,
     slots: Vec<Option<Slot>>,
     ended: VecDeque<Option<(SampleId, Vec3)>>,
-    /// The hits shaded this round, and the lane of each.
-    hits: Vec<(Ray, SurfaceHit)>,
+    /// The lanes whose hit is shaded this round.
     lanes: Vec<usize>,
-    surfaces: Vec<SurfacePoint>,
     surface: SurfaceScratch,
     /// Lanes waiting for a path (the wave held back while estimates wait).
     vacant: Vec<usize>,
@@ -195,7 +193,6 @@ pub(crate) fn radiance_lanes(
         clock.lap(Stage::PathRays);
 
         // What each path found, and the numbers of each vertex that scatters.
-        s.hits.clear();
         s.lanes.clear();
         for (lane, slot) in s.slots.iter_mut().enumerate() {
             let Some(slot) = slot else {
@@ -264,7 +261,9 @@ pub(crate) fn radiance_lanes(
             b[rows::SHADE][l] = 1.0;
             b[rows::DIFFUSE][l] = if diffuse { 1.0 } else { 0.0 };
             set3(b, rows::ALBEDO, l, albedo);
-            s.hits.push((ray, on_surface));
+            (b[rows::T][l], b[rows::NEAR][l]) = (on_surface.t, on_surface.object as f32);
+            b[rows::SHELL][l] = on_surface.epsilon;
+            debug_assert!(!on_surface.inside, "the camera is outside every solid");
             s.lanes.push(lane);
             if numbers_in_lanes {
                 continue;
@@ -297,20 +296,16 @@ pub(crate) fn radiance_lanes(
         }
         clock.lap(Stage::VertexNumbers);
 
-        SurfacePoint::at_hits(
+        SurfacePoint::at_source(
             scene,
             &march,
             level,
-            &s.hits,
+            &mut RowHits {
+                blocks: &mut s.blocks,
+                lanes: &s.lanes,
+            },
             &mut s.surface,
-            &mut s.surfaces,
         );
-        for (surface, &lane) in s.surfaces.iter().zip(&s.lanes) {
-            let (b, l) = (&mut s.blocks[lane / LANES], lane % LANES);
-            set3(b, rows::P, l, surface.p);
-            set3(b, rows::N, l, surface.n);
-            set3(b, rows::ORIGIN, l, surface.origin);
-        }
         clock.lap(Stage::ShadingPoints);
 
         // The level is available: `or_widest` says so.
@@ -320,16 +315,22 @@ pub(crate) fn radiance_lanes(
         });
         // A mirror's bounce (`strategy::mirror`), and an estimate whose shadow ray does not
         // aim at its point, made again alone.
-        for (k, &lane) in s.lanes.iter().enumerate() {
+        for &lane in &s.lanes {
             let (b, l) = (&mut s.blocks[lane / LANES], lane % LANES);
             let diffuse = b[rows::DIFFUSE][l] > 0.0;
             if diffuse && b[rows::NEE][l] != 2.0 {
                 continue;
             }
+            let (ray, hit) = row_hit(b, l);
             let vertex = Vertex {
-                at: &s.surfaces[k],
-                wo: -get3(b, rows::D, l),
-                material: material_at(scene, s.hits[k].1),
+                at: &SurfacePoint {
+                    p: get3(b, rows::P, l),
+                    n: get3(b, rows::N, l),
+                    origin: get3(b, rows::ORIGIN, l),
+                    inside: false,
+                },
+                wo: -ray.dir,
+                material: material_at(scene, hit),
             };
             if !diffuse {
                 let bounce = strategy::mirror(&vertex, Vec2::ZERO);
@@ -398,6 +399,58 @@ pub(crate) fn radiance_lanes(
         clock.lap(Stage::Estimates);
     }
     debug_assert!(s.ended.is_empty(), "every estimate handed on");
+}
+
+/// Lane `l`'s path ray and the surface it hit, shaded this round.
+#[inline(always)]
+fn row_hit(b: &Block, l: usize) -> (Ray, SurfaceHit) {
+    let ray = Ray {
+        origin: get3(b, rows::O, l),
+        dir: get3(b, rows::D, l),
+    };
+    let hit = SurfaceHit {
+        t: b[rows::T][l],
+        object: b[rows::NEAR][l] as usize,
+        epsilon: b[rows::SHELL][l],
+        inside: false,
+    };
+    (ray, hit)
+}
+
+/// The hits shaded this round, in the rows: hit `k` is lane `lanes[k]`'s, and its shading
+/// point goes to its rows `P`, `N` and `ORIGIN` (not `inside`: the camera is outside every
+/// solid, so no path is in one).
+struct RowHits<'a> {
+    blocks: &'a mut [Block],
+    lanes: &'a [usize],
+}
+
+impl HitSource for RowHits<'_> {
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.lanes.len()
+    }
+
+    #[inline(always)]
+    fn object(&self, k: usize) -> usize {
+        let lane = self.lanes[k];
+        self.blocks[lane / LANES][rows::NEAR][lane % LANES] as usize
+    }
+
+    #[inline(always)]
+    fn hit(&self, k: usize) -> (Ray, SurfaceHit) {
+        let lane = self.lanes[k];
+        row_hit(&self.blocks[lane / LANES], lane % LANES)
+    }
+
+    #[inline(always)]
+    fn put(&mut self, k: usize, point: SurfacePoint) {
+        let lane = self.lanes[k];
+        let (b, l) = (&mut self.blocks[lane / LANES], lane % LANES);
+        set3(b, rows::P, l, point.p);
+        set3(b, rows::N, l, point.n);
+        set3(b, rows::ORIGIN, l, point.origin);
+    }
 }
 
 /// A new path in lane `l` of `b`, with its camera ray: as `Path::START`.

@@ -76,8 +76,11 @@ pub(super) const WVALID: usize = 68;
 pub(super) const ENDED: usize = 69;
 pub(super) const EPS_REL: usize = 70;
 
+/// The shell of the surface hit (`SurfaceHit::epsilon`).
+pub(super) const SHELL: usize = 71;
+
 /// Rows per block.
-pub(super) const COUNT: usize = 71;
+pub(super) const COUNT: usize = 72;
 
 /// A block in its first state: no path, every value finite.
 pub(super) const EMPTY: Block = [[0.0; LANES]; COUNT];

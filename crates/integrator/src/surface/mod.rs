@@ -15,7 +15,7 @@ use crate::{Hit, PreparedScene};
 
 mod stream;
 
-pub(crate) use stream::SurfaceScratch;
+pub(crate) use stream::{HitSource, SurfaceScratch};
 
 /// A hit on an object's surface, as [`crate::Hit::Surface`] reports it.
 #[derive(Clone, Copy, Debug)]

@@ -32,9 +32,23 @@ impl SurfacePoint {
             );
             return;
         }
-        let level = level.or_widest();
         out.resize(hits.len(), SurfacePoint::UNSET);
-        scratch.group_by_object(hits, scene.scene().objects.len());
+        SurfacePoint::at_source(scene, march, level, &mut HitList { hits, out }, scratch);
+    }
+
+    /// [`SurfacePoint::at_hits`] in fast marching, for hits kept anywhere: each of
+    /// `source`'s hits shaded, object by object, a vector of hits at a time on `level`,
+    /// and its point handed back to `source`.
+    pub(crate) fn at_source<H: HitSource>(
+        scene: &PreparedScene,
+        march: &March,
+        level: SimdLevel,
+        source: &mut H,
+        scratch: &mut SurfaceScratch,
+    ) {
+        debug_assert_eq!(march.marching, Marching::Fast);
+        let level = level.or_widest();
+        scratch.group_by_object(source, scene.scene().objects.len());
         for (object, group) in scratch.groups.windows(2).enumerate() {
             let group = &scratch.order[group[0] as usize..group[1] as usize];
             if group.is_empty() {
@@ -44,11 +58,51 @@ impl SurfacePoint {
             let _ = level.dispatch(HitsOnObject {
                 sdf: scene.prepared(object),
                 march,
-                hits,
                 group,
-                out,
+                source: &mut *source,
             });
         }
+    }
+}
+
+/// Where [`SurfacePoint::at_source`] finds its hits and puts their shading points: hit
+/// `k` of `0..len()`.
+pub(crate) trait HitSource {
+    /// How many hits.
+    fn len(&self) -> usize;
+    /// The object hit `k` lies on.
+    fn object(&self, k: usize) -> usize;
+    /// Hit `k`, with the ray that found it.
+    fn hit(&self, k: usize) -> (Ray, SurfaceHit);
+    /// Hit `k`'s shading point.
+    fn put(&mut self, k: usize, point: SurfacePoint);
+}
+
+/// The hits of [`SurfacePoint::at_hits`], each with its ray, and their points, in order.
+struct HitList<'a> {
+    hits: &'a [(Ray, SurfaceHit)],
+    out: &'a mut [SurfacePoint],
+}
+
+impl HitSource for HitList<'_> {
+    #[inline(always)]
+    fn len(&self) -> usize {
+        self.hits.len()
+    }
+
+    #[inline(always)]
+    fn object(&self, k: usize) -> usize {
+        self.hits[k].1.object
+    }
+
+    #[inline(always)]
+    fn hit(&self, k: usize) -> (Ray, SurfaceHit) {
+        self.hits[k]
+    }
+
+    #[inline(always)]
+    fn put(&mut self, k: usize, point: SurfacePoint) {
+        self.out[k] = point;
     }
 }
 
@@ -64,12 +118,12 @@ pub(crate) struct SurfaceScratch {
 impl SurfaceScratch {
     /// Fills `order` and `groups` with the hits grouped by object (a counting sort, which
     /// keeps each object's hits in their order).
-    fn group_by_object(&mut self, hits: &[(Ray, SurfaceHit)], objects: usize) {
+    fn group_by_object<H: HitSource>(&mut self, hits: &H, objects: usize) {
         let groups = &mut self.groups;
         groups.clear();
         groups.resize(objects + 1, 0);
-        for (_, hit) in hits {
-            groups[hit.object + 1] += 1;
+        for k in 0..hits.len() {
+            groups[hits.object(k) + 1] += 1;
         }
         for i in 1..groups.len() {
             groups[i] += groups[i - 1];
@@ -77,8 +131,8 @@ impl SurfaceScratch {
         self.order.clear();
         self.order.resize(hits.len(), 0);
         // `groups[object]` walks through the object's slots, then is put back.
-        for (k, (_, hit)) in hits.iter().enumerate() {
-            let slot = &mut groups[hit.object];
+        for k in 0..hits.len() {
+            let slot = &mut groups[hits.object(k)];
             self.order[*slot as usize] = k as u32;
             *slot += 1;
         }
@@ -106,16 +160,15 @@ enum Round<L: Lane> {
 /// moves along the normal). A hit whose surface curves on the scale of the step
 /// ([`Approach::curved`]), or whose grazing Newton step the field or the gradient refused
 /// ([`Approach::start`], [`Approach::stencil_refuses`]), is shaded again alone.
-struct HitsOnObject<'a> {
+struct HitsOnObject<'a, H> {
     sdf: &'a PreparedSdf,
     march: &'a March,
-    hits: &'a [(Ray, SurfaceHit)],
-    /// The indices in `hits` of the hits on this object.
+    /// The indices in `source` of the hits on this object.
     group: &'a [u32],
-    out: &'a mut [SurfacePoint],
+    source: &'a mut H,
 }
 
-impl LaneKernel for HitsOnObject<'_> {
+impl<H: HitSource> LaneKernel for HitsOnObject<'_, H> {
     type Output = ();
 
     #[inline(always)]
@@ -128,7 +181,7 @@ impl LaneKernel for HitsOnObject<'_> {
             let mut rows = [[0.0; MAX_LANES]; 8];
             for j in 0..lanes {
                 let k = if j < chunk.len() { chunk[j] } else { chunk[0] };
-                let (ray, hit) = &self.hits[k as usize];
+                let (ray, hit) = self.source.hit(k as usize);
                 let at = ray.at(hit.t);
                 let row = [
                     at.x,
@@ -222,17 +275,19 @@ impl LaneKernel for HitsOnObject<'_> {
             let inside = L::bits(s.inside);
             for (j, &k) in chunk.iter().enumerate() {
                 if redo >> j & 1 != 0 {
-                    let (ray, hit) = &self.hits[k as usize];
-                    self.out[k as usize] = SurfacePoint::shaded_alone(sdf, ray, hit, self.march);
+                    let (ray, hit) = self.source.hit(k as usize);
+                    let point = SurfacePoint::shaded_alone(sdf, &ray, &hit, self.march);
+                    self.source.put(k as usize, point);
                     continue;
                 }
                 let v = |r: usize| Vec3::new(out[r][j], out[r + 1][j], out[r + 2][j]);
-                self.out[k as usize] = SurfacePoint {
+                let point = SurfacePoint {
                     p: v(0),
                     n: v(3),
                     origin: v(6),
                     inside: inside >> j & 1 != 0,
                 };
+                self.source.put(k as usize, point);
             }
         }
     }
