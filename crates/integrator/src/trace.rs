@@ -112,6 +112,72 @@ impl TraceCounters {
     }
 }
 
+/// [`TraceCounters::record`] for the rays of many vectors, each lane a ray: what a kernel
+/// counts as it goes, added to the counters once at its end ([`CountLanes::add_to`]).
+/// The steps are summed per lane in `f32`, exact below 2^24 steps a lane.
+pub(crate) struct CountLanes<L: Lane> {
+    rays: u64,
+    hits: u64,
+    gave_up: u64,
+    steps: L,
+    /// Rays of at least `2^k` steps, `k` from 1.
+    at_least: [u64; STEP_BUCKETS],
+}
+
+impl<L: Lane> CountLanes<L> {
+    #[inline(always)]
+    pub fn new() -> CountLanes<L> {
+        CountLanes {
+            rays: 0,
+            hits: 0,
+            gave_up: 0,
+            steps: L::splat(0.0),
+            at_least: [0; STEP_BUCKETS],
+        }
+    }
+
+    /// The rays of the lanes of `rays`, each of `steps` (whole numbers), that hit (`hit`)
+    /// or gave up (`gave_up`, never with `hit`) or else missed.
+    #[inline(always)]
+    pub fn record(&mut self, rays: L::Mask, steps: L, hit: L::Mask, gave_up: L::Mask) {
+        let count = |m: L::Mask| u64::from(L::bits(m).count_ones());
+        let n = count(rays);
+        if n == 0 {
+            return;
+        }
+        self.rays += n;
+        self.hits += count(L::and(rays, hit));
+        self.gave_up += count(L::and(rays, gave_up));
+        self.steps = self.steps + L::select(rays, steps, L::splat(0.0));
+        let mut longer = rays;
+        for k in 1..STEP_BUCKETS {
+            longer = L::and(longer, steps.ge(L::splat((1u32 << k) as f32)));
+            let c = count(longer);
+            if c == 0 {
+                break;
+            }
+            self.at_least[k] += c;
+        }
+    }
+
+    /// Adds what was counted to `counters`.
+    pub fn add_to(&self, counters: &mut TraceCounters) {
+        let mut steps = [0.0f32; MAX_LANES];
+        self.steps.store(&mut steps[..L::LANES]);
+        counters.rays += self.rays;
+        counters.steps += steps.iter().map(|&s| s as u64).sum::<u64>();
+        counters.hits += self.hits;
+        counters.gave_up += self.gave_up;
+        counters.misses += self.rays - self.hits - self.gave_up;
+        let mut at_least = self.at_least;
+        at_least[0] = self.rays;
+        for k in 0..STEP_BUCKETS {
+            let next = at_least.get(k + 1).copied().unwrap_or(0);
+            counters.steps_histogram[k] += at_least[k] - next;
+        }
+    }
+}
+
 /// Counters per kind of ray.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RayCounters {
@@ -573,6 +639,49 @@ mod tests {
         Scene::new(crowd(), vec![white], vec![], None, camera)
             .unwrap()
             .into()
+    }
+
+    /// Rays counted a vector at a time are the counts of each ray recorded alone, on every
+    /// level, with steps in every bucket and every outcome.
+    #[test]
+    fn rays_counted_in_lanes_are_each_ray_s_record() {
+        struct Count<'a>(&'a [(u32, u8)], &'a mut TraceCounters);
+        impl LaneKernel for Count<'_> {
+            type Output = ();
+            fn run<L: Lane>(self) {
+                let mut lanes = CountLanes::<L>::new();
+                for chunk in self.0.chunks(L::LANES) {
+                    let mut rows = [[0.0f32; MAX_LANES]; 4];
+                    for (j, &(steps, kind)) in chunk.iter().enumerate() {
+                        rows[0][j] = 1.0;
+                        rows[1][j] = steps as f32;
+                        rows[2][j] = f32::from(kind == 0);
+                        rows[3][j] = f32::from(kind == 1);
+                    }
+                    let [rays, steps, hit, gave_up] = rows.map(|r| L::load(&r[..L::LANES]));
+                    let half = L::splat(0.5);
+                    lanes.record(rays.gt(half), steps, hit.gt(half), gave_up.gt(half));
+                }
+                lanes.add_to(self.1);
+            }
+        }
+        let rays: Vec<(u32, u8)> = (0..300u32)
+            .map(|i| ((i * 7919) % 1500 >> (i % 11), (i % 3) as u8))
+            .collect();
+        let mut alone = TraceCounters::default();
+        for &(steps, kind) in &rays {
+            alone.record(&match kind {
+                0 => TraceOutcome::Hit { t: 1.0, steps },
+                1 => TraceOutcome::GaveUp { t: 1.0, steps },
+                _ => TraceOutcome::Miss { steps },
+            });
+        }
+        assert!(alone.steps_histogram.iter().all(|&n| n > 0));
+        for level in SimdLevel::available() {
+            let mut counted = TraceCounters::default();
+            level.dispatch(Count(&rays, &mut counted)).unwrap();
+            assert_eq!(counted, alone, "{level:?}");
+        }
     }
 
     #[test]

@@ -12,7 +12,7 @@ use crate::geometry::Geometry;
 use crate::next_event::{AimedSphereLanes, DiffuseLanes, all_zero, sphere_next_event_lanes};
 use crate::roulette::roulette_lanes;
 use crate::strategy::{DIMS_PER_VERTEX, VertexSample};
-use crate::trace::nearest_light_lanes;
+use crate::trace::{CountLanes, RayCounters, TraceCounters, nearest_light_lanes};
 
 /// The lanes whose next-event estimate found a shadow ray to trace (`rows::NEE` 1).
 #[inline(always)]
@@ -44,6 +44,8 @@ pub(super) struct PathRays<'a> {
     pub camera: TraceParams,
     pub secondary: TraceParams,
     pub blocks: &'a mut [Block],
+    /// The camera's and the bounces' counters, where each ray is recorded.
+    pub counters: &'a mut RayCounters,
 }
 
 impl LaneKernel for PathRays<'_> {
@@ -57,7 +59,9 @@ impl LaneKernel for PathRays<'_> {
             camera: c,
             secondary: s,
             blocks,
+            counters,
         } = self;
+        let (mut camera, mut bounce) = (CountLanes::<V>::new(), CountLanes::<V>::new());
         for b in blocks.iter_mut() {
             for at in (0..LANES).step_by(V::LANES) {
                 let alive = ld_mask::<V>(b, rows::ALIVE, at);
@@ -97,8 +101,20 @@ impl LaneKernel for PathRays<'_> {
                 st(eps_rel, b, rows::EPS_REL, at);
                 st(best, b, rows::LIGHT, at);
                 st(best_t, b, rows::LIGHT_T, at);
+                // A hit first, as the outcome read from the rows takes it.
+                let gave_up = V::and(ends.gave_up(), V::not(ends.hit()));
+                let outcome = (ends.steps(), ends.hit(), gave_up);
+                camera.record(V::and(alive, first), outcome.0, outcome.1, outcome.2);
+                bounce.record(
+                    V::and(alive, V::not(first)),
+                    outcome.0,
+                    outcome.1,
+                    outcome.2,
+                );
             }
         }
+        camera.add_to(&mut counters.camera);
+        bounce.add_to(&mut counters.bounce);
     }
 }
 
@@ -219,6 +235,8 @@ pub(super) struct ShadowRays<'a> {
     pub geometry: &'a Geometry,
     pub params: TraceParams,
     pub blocks: &'a mut [Block],
+    /// The shadow rays' counters, where each ray marched is recorded.
+    pub counters: &'a mut TraceCounters,
 }
 
 impl LaneKernel for ShadowRays<'_> {
@@ -230,12 +248,13 @@ impl LaneKernel for ShadowRays<'_> {
             geometry,
             params,
             blocks,
+            counters,
         } = self;
+        let mut count = CountLanes::<V>::new();
         for b in blocks.iter_mut() {
             for at in (0..LANES).step_by(V::LANES) {
                 let found = shadow_ray_found::<V>(b, at);
                 if !V::any(found) {
-                    st_mask::<V>(found, b, rows::MARCHED, at);
                     continue;
                 }
                 let origin = ld3::<V>(b, rows::ORIGIN, at);
@@ -262,11 +281,13 @@ impl LaneKernel for ShadowRays<'_> {
                 // is taken as a hit.
                 let blocked = V::and(marched, V::or(ends.hit(), ends.gave_up()));
                 st_mask::<V>(V::not(blocked), b, rows::FREE, at);
-                st_mask::<V>(marched, b, rows::MARCHED, at);
-                st_mask::<V>(ends.gave_up(), b, rows::S_GAVE_UP, at);
-                st(ends.steps(), b, rows::S_STEPS, at);
+                // A free ray missed; a blocked one gave up, or else hit.
+                let gave_up = V::and(blocked, ends.gave_up());
+                let hit = V::and(blocked, V::not(ends.gave_up()));
+                count.record(marched, ends.steps(), hit, gave_up);
             }
         }
+        count.add_to(counters);
     }
 }
 

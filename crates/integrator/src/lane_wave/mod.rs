@@ -188,6 +188,7 @@ pub(crate) fn radiance_lanes(
             camera: march.camera,
             secondary: march.secondary,
             blocks: &mut s.blocks,
+            counters,
         });
         counters.timed_paths(time, before);
         clock.lap(Stage::PathRays);
@@ -202,7 +203,6 @@ pub(crate) fn radiance_lanes(
             let l = lane % LANES;
             b[rows::SHADE][l] = 0.0;
             let outcome = path_outcome(b, l);
-            counters.path_ray(b[rows::DEPTH][l] == 0.0).record(&outcome);
             let ray = Ray {
                 origin: get3(b, rows::O, l),
                 dir: get3(b, rows::D, l),
@@ -362,8 +362,8 @@ pub(crate) fn radiance_lanes(
             geometry: &scene.geometry,
             params: lighting.params,
             blocks: &mut s.blocks,
+            counters: &mut counters.shadow,
         });
-        count_shadow_rays(&s.blocks, &s.lanes, counters);
         counters.shadow.timed(time);
         clock.lap(Stage::ShadowRays);
 
@@ -476,24 +476,5 @@ fn path_outcome(b: &Block, l: usize) -> TraceOutcome {
         TraceOutcome::GaveUp { t, steps }
     } else {
         TraceOutcome::Miss { steps }
-    }
-}
-
-/// Each shadow ray marched, in the shadow rays' counters (their `t` is not kept).
-fn count_shadow_rays(blocks: &[Block], lanes: &[usize], counters: &mut RayCounters) {
-    for &lane in lanes {
-        let (b, l) = (&blocks[lane / LANES], lane % LANES);
-        if b[rows::MARCHED][l] == 0.0 {
-            continue;
-        }
-        let steps = b[rows::S_STEPS][l] as u32;
-        let outcome = if b[rows::FREE][l] > 0.0 {
-            TraceOutcome::Miss { steps }
-        } else if b[rows::S_GAVE_UP][l] > 0.0 {
-            TraceOutcome::GaveUp { t: 0.0, steps }
-        } else {
-            TraceOutcome::Hit { t: 0.0, steps }
-        };
-        counters.shadow.record(&outcome);
     }
 }

@@ -57,30 +57,27 @@ pub(super) const U_ROULETTE: usize = 48;
 
 /// Next-event estimation: `NEE` is 0 (nothing), 1 (a shadow ray along `SD` to `SDIST`
 /// that brings `C` if free, `FREE` once traced) or 2 (the estimate made again alone, its
-/// aim not at its point); `S_STEPS` and `MARCHED`, the shadow ray's march.
+/// aim not at its point).
 pub(super) const NEE: usize = 49;
 pub(super) const SD: usize = 50;
 pub(super) const SDIST: usize = 53;
 pub(super) const C: usize = 54;
 pub(super) const FREE: usize = 57;
-pub(super) const S_STEPS: usize = 58;
-pub(super) const MARCHED: usize = 59;
-pub(super) const S_GAVE_UP: usize = 60;
 
 /// The scatter: its direction `WI`, weight `WEIGHT` and pdf `WPDF`, whether it carries
 /// any (`WVALID`); `ENDED`: the path ended this round.
-pub(super) const WI: usize = 61;
-pub(super) const WEIGHT: usize = 64;
-pub(super) const WPDF: usize = 67;
-pub(super) const WVALID: usize = 68;
-pub(super) const ENDED: usize = 69;
-pub(super) const EPS_REL: usize = 70;
+pub(super) const WI: usize = 58;
+pub(super) const WEIGHT: usize = 61;
+pub(super) const WPDF: usize = 64;
+pub(super) const WVALID: usize = 65;
+pub(super) const ENDED: usize = 66;
+pub(super) const EPS_REL: usize = 67;
 
 /// The shell of the surface hit (`SurfaceHit::epsilon`).
-pub(super) const SHELL: usize = 71;
+pub(super) const SHELL: usize = 68;
 
 /// Rows per block.
-pub(super) const COUNT: usize = 72;
+pub(super) const COUNT: usize = 69;
 
 /// A block in its first state: no path, every value finite.
 pub(super) const EMPTY: Block = [[0.0; LANES]; COUNT];
