@@ -195,10 +195,9 @@ pub(crate) fn radiance_lanes(
 
         // What each path found, and the numbers of each vertex that scatters.
         s.lanes.clear();
-        for (lane, slot) in s.slots.iter_mut().enumerate() {
-            let Some(slot) = slot else {
-                continue;
-            };
+        // The live lanes, found by their rows (a slot, with its sampler, is large, and the
+        // independent kind's numbers never read it).
+        for lane in lanes_where(&s.blocks, rows::ALIVE) {
             let b = &mut s.blocks[lane / LANES];
             let l = lane % LANES;
             b[rows::SHADE][l] = 0.0;
@@ -268,6 +267,7 @@ pub(crate) fn radiance_lanes(
             if numbers_in_lanes {
                 continue;
             }
+            let slot = s.slots[lane].as_mut().expect("a live lane's path");
             let mut u = VertexSample::UNSET;
             u.draw(
                 &mut slot.sampler,
@@ -374,22 +374,15 @@ pub(crate) fn radiance_lanes(
         });
         clock.lap(Stage::Scattering);
 
-        // The paths that ended leave their estimates and their lanes, found by their rows
-        // (a slot, with its sampler, is large).
-        for (v, b) in s.blocks.iter_mut().enumerate() {
-            for l in 0..LANES {
-                if b[rows::ENDED][l] == 0.0 {
-                    continue;
-                }
-                (b[rows::ENDED][l], b[rows::ALIVE][l], b[rows::SHADE][l]) = (0.0, 0.0, 0.0);
-                let lane = v * LANES + l;
-                let Some(slot) = &s.slots[lane] else {
-                    continue;
-                };
-                s.ended[(slot.ordinal - handed) as usize] = Some((slot.id, get3(b, rows::L, l)));
-                s.slots[lane] = None;
-                s.vacant.push(lane);
-            }
+        // The paths that ended leave their estimates and their lanes, found by their rows.
+        for lane in lanes_where(&s.blocks, rows::ENDED) {
+            let (b, l) = (&mut s.blocks[lane / LANES], lane % LANES);
+            (b[rows::ENDED][l], b[rows::ALIVE][l], b[rows::SHADE][l]) = (0.0, 0.0, 0.0);
+            let Some(slot) = s.slots[lane].take() else {
+                continue;
+            };
+            s.ended[(slot.ordinal - handed) as usize] = Some((slot.id, get3(b, rows::L, l)));
+            s.vacant.push(lane);
         }
         while let Some(Some(_)) = s.ended.front() {
             let (id, l) = s.ended.pop_front().flatten().expect("an ended path");
@@ -399,6 +392,28 @@ pub(crate) fn radiance_lanes(
         clock.lap(Stage::Estimates);
     }
     debug_assert!(s.ended.is_empty(), "every estimate handed on");
+}
+
+/// The lanes whose `row` is not 0, in order, from one test of each block's row.
+fn lanes_where(blocks: &[Block], row: usize) -> impl Iterator<Item = usize> + use<> {
+    let masks: Vec<u32> = blocks
+        .iter()
+        .map(|b| {
+            b[row]
+                .iter()
+                .enumerate()
+                .fold(0u32, |m, (l, &x)| m | u32::from(x != 0.0) << l)
+        })
+        .collect();
+    masks.into_iter().enumerate().flat_map(|(v, mut mask)| {
+        std::iter::from_fn(move || {
+            (mask != 0).then(|| {
+                let l = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                v * LANES + l
+            })
+        })
+    })
 }
 
 /// Lane `l`'s path ray and the surface it hit, shaded this round.
