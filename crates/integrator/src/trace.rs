@@ -666,7 +666,7 @@ mod tests {
             }
         }
         let rays: Vec<(u32, u8)> = (0..300u32)
-            .map(|i| ((i * 7919) % 1500 >> (i % 11), (i % 3) as u8))
+            .map(|i| (((i * 7919) % 1500) >> (i % 11), (i % 3) as u8))
             .collect();
         let mut alone = TraceCounters::default();
         for &(steps, kind) in &rays {
