@@ -109,8 +109,9 @@ pub(crate) struct LaneScratch {
     generators: Vec<PcgLanes<LANES>>,
     slots: Vec<Option<Slot>>,
     ended: VecDeque<Option<(SampleId, Vec3)>>,
-    /// The lanes whose hit is shaded this round.
+    /// The lanes whose hit is shaded this round, and the object each hit.
     lanes: Vec<usize>,
+    objects: Vec<u32>,
     surface: SurfaceScratch,
     /// Lanes waiting for a path (the wave held back while estimates wait).
     vacant: Vec<usize>,
@@ -197,6 +198,7 @@ pub(crate) fn radiance_lanes(
 
         // What each path found, and the numbers of each vertex that scatters.
         s.lanes.clear();
+        s.objects.clear();
         // The live lanes, found by their rows (a slot, with its sampler, is large, and the
         // independent kind's numbers never read it).
         for lane in lanes_where(&s.blocks, rows::ALIVE) {
@@ -266,6 +268,7 @@ pub(crate) fn radiance_lanes(
             b[rows::SHELL][l] = on_surface.epsilon;
             debug_assert!(!on_surface.inside, "the camera is outside every solid");
             s.lanes.push(lane);
+            s.objects.push(on_surface.object as u32);
             if numbers_in_lanes {
                 continue;
             }
@@ -305,6 +308,7 @@ pub(crate) fn radiance_lanes(
             &mut RowHits {
                 blocks: &mut s.blocks,
                 lanes: &s.lanes,
+                objects: &s.objects,
             },
             &mut s.surface,
         );
@@ -434,12 +438,14 @@ fn row_hit(b: &Block, l: usize) -> (Ray, SurfaceHit) {
     (ray, hit)
 }
 
-/// The hits shaded this round, in the rows: hit `k` is lane `lanes[k]`'s, and its shading
-/// point goes to its rows `P`, `N` and `ORIGIN` (not `inside`: the camera is outside every
-/// solid, so no path is in one).
+/// The hits shaded this round, in the rows: hit `k` is lane `lanes[k]`'s, on object
+/// `objects[k]` (kept apart too, so that grouping the hits by object reads one array), and
+/// its shading point goes to its rows `P`, `N` and `ORIGIN` (not `inside`: the camera is
+/// outside every solid, so no path is in one).
 struct RowHits<'a> {
     blocks: &'a mut [Block],
     lanes: &'a [usize],
+    objects: &'a [u32],
 }
 
 impl HitSource for RowHits<'_> {
@@ -450,8 +456,7 @@ impl HitSource for RowHits<'_> {
 
     #[inline(always)]
     fn object(&self, k: usize) -> usize {
-        let lane = self.lanes[k];
-        self.blocks[lane / LANES][rows::NEAR][lane % LANES] as usize
+        self.objects[k] as usize
     }
 
     #[inline(always)]
