@@ -114,12 +114,15 @@ impl TraceCounters {
 
 /// [`TraceCounters::record`] for the rays of many vectors, each lane a ray: what a kernel
 /// counts as it goes, added to the counters once at its end ([`CountLanes::add_to`]).
-/// The steps are summed per lane in `f32`, exact below 2^24 steps a lane.
+/// The steps are summed per lane in `f32` while every lane's sum stays below 2^23, so each
+/// sum is exact, and moved to an integer before.
 pub(crate) struct CountLanes<L: Lane> {
     rays: u64,
     hits: u64,
     gave_up: u64,
     steps: L,
+    /// Steps moved out of `steps`.
+    moved_steps: u64,
     /// Rays of at least `2^k` steps, `k` from 1.
     at_least: [u64; STEP_BUCKETS],
 }
@@ -132,8 +135,17 @@ impl<L: Lane> CountLanes<L> {
             hits: 0,
             gave_up: 0,
             steps: L::splat(0.0),
+            moved_steps: 0,
             at_least: [0; STEP_BUCKETS],
         }
+    }
+
+    /// The sum of the lanes of `x`, each a whole number below 2^24.
+    #[inline(always)]
+    fn lane_sum(x: L) -> u64 {
+        let mut lanes = [0.0f32; MAX_LANES];
+        x.store(&mut lanes[..L::LANES]);
+        lanes.iter().map(|&s| s as u64).sum()
     }
 
     /// The rays of the lanes of `rays`, each of `steps` (whole numbers), that hit (`hit`)
@@ -148,7 +160,17 @@ impl<L: Lane> CountLanes<L> {
         self.rays += n;
         self.hits += count(L::and(rays, hit));
         self.gave_up += count(L::and(rays, gave_up));
-        self.steps = self.steps + L::select(rays, steps, L::splat(0.0));
+        let steps_of_rays = L::select(rays, steps, L::splat(0.0));
+        let limit = L::splat(8_388_608.0);
+        if L::any(steps_of_rays.ge(limit)) {
+            self.moved_steps += Self::lane_sum(steps_of_rays);
+        } else {
+            self.steps = self.steps + steps_of_rays;
+            if L::any(self.steps.ge(limit)) {
+                self.moved_steps += Self::lane_sum(self.steps);
+                self.steps = L::splat(0.0);
+            }
+        }
         let mut longer = rays;
         for k in 1..STEP_BUCKETS {
             longer = L::and(longer, steps.ge(L::splat((1u32 << k) as f32)));
@@ -162,10 +184,8 @@ impl<L: Lane> CountLanes<L> {
 
     /// Adds what was counted to `counters`.
     pub fn add_to(&self, counters: &mut TraceCounters) {
-        let mut steps = [0.0f32; MAX_LANES];
-        self.steps.store(&mut steps[..L::LANES]);
         counters.rays += self.rays;
-        counters.steps += steps.iter().map(|&s| s as u64).sum::<u64>();
+        counters.steps += self.moved_steps + Self::lane_sum(self.steps);
         counters.hits += self.hits;
         counters.gave_up += self.gave_up;
         counters.misses += self.rays - self.hits - self.gave_up;
@@ -665,8 +685,10 @@ mod tests {
                 lanes.add_to(self.1);
             }
         }
+        // Every bucket, and sums past what an f32 holds exactly (2^24).
         let rays: Vec<(u32, u8)> = (0..300u32)
             .map(|i| (((i * 7919) % 1500) >> (i % 11), (i % 3) as u8))
+            .chain((0..40u32).map(|i| ((3 << 21) + 2 * i + 1, (i % 3) as u8)))
             .collect();
         let mut alone = TraceCounters::default();
         for &(steps, kind) in &rays {
