@@ -115,6 +115,8 @@ pub(crate) struct LaneScratch {
     surface: SurfaceScratch,
     /// Lanes waiting for a path (the wave held back while estimates wait).
     vacant: Vec<usize>,
+    /// Per block, a row's lanes as bits ([`lanes_where`]).
+    masks: Vec<u32>,
 }
 
 /// `radiance_wave`'s contract, in lanes: the radiance of the pixel samples `next` gives,
@@ -201,7 +203,7 @@ pub(crate) fn radiance_lanes(
         s.objects.clear();
         // The live lanes, found by their rows (a slot, with its sampler, is large, and the
         // independent kind's numbers never read it).
-        for lane in lanes_where(&s.blocks, rows::ALIVE) {
+        for lane in lanes_where(&s.blocks, rows::ALIVE, &mut s.masks) {
             let b = &mut s.blocks[lane / LANES];
             let l = lane % LANES;
             b[rows::SHADE][l] = 0.0;
@@ -264,9 +266,14 @@ pub(crate) fn radiance_lanes(
             b[rows::SHADE][l] = 1.0;
             b[rows::DIFFUSE][l] = if diffuse { 1.0 } else { 0.0 };
             set3(b, rows::ALBEDO, l, albedo);
-            (b[rows::T][l], b[rows::NEAR][l]) = (on_surface.t, on_surface.object as f32);
-            b[rows::SHELL][l] = on_surface.epsilon;
+            // The march's end and object are the hit's (`surface_hit` keeps them); its
+            // shell is new.
+            debug_assert_eq!(
+                (on_surface.t, on_surface.object),
+                (b[rows::T][l], b[rows::NEAR][l] as usize)
+            );
             debug_assert!(!on_surface.inside, "the camera is outside every solid");
+            b[rows::SHELL][l] = on_surface.epsilon;
             s.lanes.push(lane);
             s.objects.push(on_surface.object as u32);
             if numbers_in_lanes {
@@ -381,7 +388,7 @@ pub(crate) fn radiance_lanes(
         clock.lap(Stage::Scattering);
 
         // The paths that ended leave their estimates and their lanes, found by their rows.
-        for lane in lanes_where(&s.blocks, rows::ENDED) {
+        for lane in lanes_where(&s.blocks, rows::ENDED, &mut s.masks) {
             let (b, l) = (&mut s.blocks[lane / LANES], lane % LANES);
             (b[rows::ENDED][l], b[rows::ALIVE][l], b[rows::SHADE][l]) = (0.0, 0.0, 0.0);
             let Some(slot) = s.slots[lane].take() else {
@@ -400,18 +407,22 @@ pub(crate) fn radiance_lanes(
     debug_assert!(s.ended.is_empty(), "every estimate handed on");
 }
 
-/// The lanes whose `row` is not 0, in order, from one test of each block's row.
-fn lanes_where(blocks: &[Block], row: usize) -> impl Iterator<Item = usize> + use<> {
-    let masks: Vec<u32> = blocks
-        .iter()
-        .map(|b| {
-            b[row]
-                .iter()
-                .enumerate()
-                .fold(0u32, |m, (l, &x)| m | u32::from(x != 0.0) << l)
-        })
-        .collect();
-    masks.into_iter().enumerate().flat_map(|(v, mut mask)| {
+/// The lanes whose `row` is not 0, in order, from one test of each block's row (its bits
+/// kept in `masks`, so that the blocks can change while the lanes are visited).
+fn lanes_where<'m>(
+    blocks: &[Block],
+    row: usize,
+    masks: &'m mut Vec<u32>,
+) -> impl Iterator<Item = usize> + use<'m> {
+    masks.clear();
+    masks.extend(blocks.iter().map(|b| {
+        b[row]
+            .iter()
+            .enumerate()
+            .fold(0u32, |m, (l, &x)| m | u32::from(x != 0.0) << l)
+    }));
+    masks.iter().enumerate().flat_map(|(v, &mask)| {
+        let mut mask = mask;
         std::iter::from_fn(move || {
             (mask != 0).then(|| {
                 let l = mask.trailing_zeros() as usize;
