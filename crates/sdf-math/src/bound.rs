@@ -171,20 +171,18 @@ impl<L: Lane> Slope<L> {
         }
     }
 
-    /// On axis `axis`, the interval `{t : alpha + slope t < 0}` within `[t_min, t_max]`,
-    /// an empty one as `(inf, -inf)` so that it drops out of a hull (the hull of a
-    /// half-line at negative `t` and one at positive `t` is everything, clipped first it
-    /// is the second).
+    /// On axis `axis`, the half-line `{t : alpha + slope t < 0}` as `(lo, hi)`, the other
+    /// end infinite. A NaN root bounds nothing: [`box_axis`] folds each end in with
+    /// `max_cmp` or `min_cmp`, which drop a NaN in either place. Not clipped to the trace's range nor
+    /// tested for emptiness here: the box intersects it with the other face's half-line
+    /// and then clips once, which is the same interval for half the work.
     #[inline(always)]
-    fn below(&self, axis: usize, alpha: L, t_min: L, t_max: L) -> (L, L) {
+    fn below(&self, axis: usize, alpha: L) -> (L, L) {
         let (inv, rising) = (component(self.inv, axis), self.rising[axis]);
         let root = -alpha * inv;
-        let lo = L::select(rising, t_min, root.max_cmp(t_min));
-        let hi = L::select(rising, root.min_cmp(t_max), t_max);
-        let empty = lo.gt(hi);
         (
-            L::select(empty, L::splat(f32::INFINITY), lo),
-            L::select(empty, L::splat(f32::NEG_INFINITY), hi),
+            L::select(rising, L::splat(f32::NEG_INFINITY), root),
+            L::select(rising, root, L::splat(f32::INFINITY)),
         )
     }
 }
@@ -211,9 +209,12 @@ fn box_axis<L: Lane>(clip: &RayClipLanes<L>, aabb: &Aabb, axis: usize) -> (L, L)
     // a candidate for it however close above it starts.
     let scale = o.abs().max_cmp(min.abs()).max_cmp(max.abs());
     let slack = L::splat(4.0 * f32::EPSILON) * scale + clip.eps_abs;
-    let (lo_up, hi_up) = up.below(axis, o - max - slack, t_min, t_max);
-    let (lo_down, hi_down) = down.below(axis, min - o - slack, t_min, t_max);
-    (lo_up.max_cmp(lo_down), hi_up.min_cmp(hi_down))
+    let (lo_up, hi_up) = up.below(axis, o - max - slack);
+    let (lo_down, hi_down) = down.below(axis, min - o - slack);
+    (
+        lo_up.max_cmp(lo_down.max_cmp(t_min)),
+        hi_up.min_cmp(hi_down.min_cmp(t_max)),
+    )
 }
 
 /// Coordinate `axis` (0, 1 or 2) of `v`.
