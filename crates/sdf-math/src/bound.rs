@@ -146,10 +146,11 @@ pub type RayClip = RayClipLanes<f32>;
 /// The slope of one family of planes along the ray, per axis.
 #[derive(Clone, Copy, Debug)]
 struct Slope<L: Lane> {
-    /// `1 / slope`, with a zero slope replaced by a tiny positive one, so that
+    /// `-1 / slope` (negated once here rather than each root's numerator at every box,
+    /// which is the same product), with a zero slope replaced by a tiny positive one, so that
     /// `a + 0 t < 0` comes out as "every t" for negative `a` and "none" for positive `a`
     /// with no special case.
-    inv: LaneVec3<L>,
+    neg_inv: LaneVec3<L>,
     /// Where the slope is positive: the set is `t < root`; elsewhere `t > root`.
     rising: [L::Mask; 3],
 }
@@ -162,11 +163,11 @@ impl<L: Lane> Slope<L> {
         fn per_axis<L: Lane>(s: L) -> (L, L::Mask) {
             let zero = L::splat(0.0);
             let s = L::select(L::and(s.ge(zero), L::not(s.gt(zero))), L::splat(1e-30), s);
-            (L::splat(1.0) / s, s.gt(zero))
+            (-(L::splat(1.0) / s), s.gt(zero))
         }
         let ((x, rx), (y, ry), (z, rz)) = (per_axis(slope.x), per_axis(slope.y), per_axis(slope.z));
         Slope {
-            inv: LaneVec3::new(x, y, z),
+            neg_inv: LaneVec3::new(x, y, z),
             rising: [rx, ry, rz],
         }
     }
@@ -178,8 +179,8 @@ impl<L: Lane> Slope<L> {
     /// and then clips once, which is the same interval for half the work.
     #[inline(always)]
     fn below(&self, axis: usize, alpha: L) -> (L, L) {
-        let (inv, rising) = (component(self.inv, axis), self.rising[axis]);
-        let root = -alpha * inv;
+        let (neg_inv, rising) = (component(self.neg_inv, axis), self.rising[axis]);
+        let root = alpha * neg_inv;
         (
             L::select(rising, L::splat(f32::NEG_INFINITY), root),
             L::select(rising, root, L::splat(f32::INFINITY)),
@@ -207,7 +208,8 @@ fn box_axis<L: Lane>(clip: &RayClipLanes<L>, aabb: &Aabb, axis: usize) -> (L, L)
     // axis (the origin's coordinate and the box's faces on that axis). Per axis, not the
     // largest coordinate of all, so that a ray leaving the top of a floor 1e4 wide is not
     // a candidate for it however close above it starts.
-    let scale = o.abs().max_cmp(min.abs()).max_cmp(max.abs());
+    let faces = aabb.min[axis].abs().max_cmp(aabb.max[axis].abs());
+    let scale = o.abs().max_cmp(L::splat(faces));
     let slack = L::splat(4.0 * f32::EPSILON) * scale + clip.eps_abs;
     let (lo_up, hi_up) = up.below(axis, o - max - slack);
     let (lo_down, hi_down) = down.below(axis, min - o - slack);
