@@ -386,7 +386,11 @@ fn the_lane_wave_gives_the_image_of_the_wave_of_records() {
     let cornell = shipped("cornell-spheres");
     let mut base = sized(&cornell.settings, [20, 12], 4);
     base.strategy = Strategy::Mis;
-    let mut cases = vec![("cornell", cornell.scene.clone(), base.clone())];
+    let mut cases = vec![(
+        "cornell, sobol-xor numbers",
+        cornell.scene.clone(),
+        base.clone(),
+    )];
     let mut capped = base.clone();
     capped.max_steps = 3;
     cases.push(("cornell, 3 steps a ray", cornell.scene.clone(), capped));

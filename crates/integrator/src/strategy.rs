@@ -23,13 +23,16 @@ use lueur_scene::{RenderSettings, Strategy};
 use crate::PreparedScene;
 use crate::trace::ShadowRay;
 
-/// Sampler dimensions consumed per path vertex, so that each bounce reads
-/// the same dimensions whatever happened before (low-discrepancy point sets
-/// keep their structure per bounce): the fields of [`VertexSample`] and one
-/// spare.
+/// Sampler dimensions consumed per path vertex, so that each bounce reads the same
+/// dimensions whatever happened before (low-discrepancy point sets keep their structure per
+/// bounce): the fields of [`VertexSample`] and one spare.
 pub(crate) const DIMS_PER_VERTEX: u32 = 8;
 /// Dimensions before the first vertex: the position in the pixel.
 pub(crate) const CAMERA_DIMS: u32 = 2;
+/// The first dimension of the vertex at `depth` ([`VertexSample::draw`] reads from it on).
+pub(crate) const fn vertex_dimension(depth: u32) -> u32 {
+    CAMERA_DIMS + depth * DIMS_PER_VERTEX
+}
 
 /// The random numbers of one vertex, in the order they are drawn (the spare
 /// eighth dimension is not drawn).
@@ -76,7 +79,7 @@ impl VertexSample {
         depth: u32,
         reads: VertexReads,
     ) {
-        sampler.start_pixel_sample(pixel, index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
+        sampler.start_pixel_sample(pixel, index, vertex_dimension(depth));
         self.emitter_choice = next_1d_read(sampler, reads.emitter_choice);
         self.emitter = next_2d_read(sampler, reads.emitter);
         self.mixture = next_1d_read(sampler, reads.mixture);
@@ -446,10 +449,9 @@ impl LaneKernel for DrawScatters<'_> {
     }
 }
 
-/// Whether `strategy` adds next-event estimation (a shadow ray toward a
-/// chosen emitter) at each diffuse vertex, besides the direction it
-/// scatters in; the weight of emission found along that direction then
-/// accounts for it.
+/// Whether `strategy` adds next-event estimation (a shadow ray toward a chosen emitter) at
+/// each diffuse vertex, besides the direction it scatters in; the weight of emission found
+/// along that direction then accounts for it.
 pub(crate) fn uses_next_event(strategy: Strategy) -> bool {
     match strategy {
         Strategy::Mis => true,
@@ -500,9 +502,8 @@ fn bsdf_sample(
     }
 }
 
-/// `light`: a direction toward a chosen emitter only, with the pdf summed
-/// over every emitter (biased: directions no emitter subtends are never
-/// taken).
+/// `light`: a direction toward a chosen emitter only, with the pdf summed over every
+/// emitter (biased: directions no emitter subtends are never taken).
 pub(crate) fn toward_emitters(
     emitters: &Emitters<'_>,
     v: &Vertex<'_>,
@@ -536,9 +537,8 @@ pub(crate) fn mixture(
     weighted(v, wi, mixture_pdf(emitters, v, wi))
 }
 
-/// The pdf with which [`mixture`] picks `wi`: the average of the uniform
-/// hemisphere's and the emitters', or the hemisphere's alone without
-/// emitters.
+/// The pdf with which [`mixture`] picks `wi`: the average of the uniform hemisphere's and
+/// the emitters', or the hemisphere's alone without emitters.
 pub(crate) fn mixture_pdf(emitters: &Emitters<'_>, v: &Vertex<'_>, wi: Vec3) -> f32 {
     let hemisphere_pdf = v
         .material
@@ -550,9 +550,8 @@ pub(crate) fn mixture_pdf(emitters: &Emitters<'_>, v: &Vertex<'_>, wi: Vec3) -> 
     }
 }
 
-/// `mis`'s BSDF half: cosine sampling, with emission found along it weighted
-/// against next-event estimation ([`Lighting::next_event`] is the other
-/// half).
+/// `mis`'s BSDF half: cosine sampling, with emission found along it weighted against
+/// next-event estimation ([`Lighting::next_event`] is the other half).
 ///
 /// Always inlined: out of line, its result comes back through memory, stored in pieces
 /// and loaded whole.
@@ -718,7 +717,7 @@ mod tests {
         let reads = VertexReads::of(Strategy::Mixture, true, true, true);
         u.draw(&mut sampler, pixel, index, depth, reads);
         let mut dims = [0.0f32; DIMS_PER_VERTEX as usize];
-        sampler.start_pixel_sample(pixel, index, CAMERA_DIMS + depth * DIMS_PER_VERTEX);
+        sampler.start_pixel_sample(pixel, index, vertex_dimension(depth));
         for d in &mut dims {
             *d = sampler.next_1d();
         }

@@ -9,7 +9,7 @@ pub(crate) const GOLDEN_GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
 /// splitmix64's output function (Steele, Lea and Flood 2014, "Fast
 /// splittable pseudorandom number generators", OOPSLA; constants from
 /// Stafford's "Mix13"): a bijective 64-bit mixer with good avalanche.
-#[inline]
+#[inline(always)]
 pub const fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
@@ -19,7 +19,7 @@ pub const fn mix64(mut z: u64) -> u64 {
 /// Hash of two words. Not symmetric: `hash2(a, b) != hash2(b, a)` in
 /// general, so `(seed, dimension)` and `(dimension, seed)` give different
 /// streams.
-#[inline]
+#[inline(always)]
 pub fn hash2(a: u64, b: u64) -> u64 {
     hash2_keyed(a, hash_key(b))
 }
@@ -27,13 +27,13 @@ pub fn hash2(a: u64, b: u64) -> u64 {
 /// What [`hash2`] makes of its second word alone: `hash2(a, b)` is
 /// `hash2_keyed(a, hash_key(b))`, so that a caller hashing many `a`s with
 /// few `b`s (a sampler's dimensions) can make the keys once.
-#[inline]
+#[inline(always)]
 pub const fn hash_key(b: u64) -> u64 {
     mix64(b.wrapping_add(GOLDEN_GAMMA))
 }
 
 /// [`hash2`] of `a` and the word `key` was made from by [`hash_key`].
-#[inline]
+#[inline(always)]
 pub fn hash2_keyed(a: u64, key: u64) -> u64 {
     mix64(a ^ key)
 }

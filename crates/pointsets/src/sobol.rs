@@ -144,7 +144,7 @@ pub fn sobol_u32(index: u32, dimension: usize) -> u32 {
 /// der Corput's, which is the bit reversal itself) and 1 need no reversal back. The
 /// other dimensions reverse the index and read [`sobol_u32`].
 /// Panics if `dimension >= SOBOL_MAX_DIMENSIONS`.
-#[inline]
+#[inline(always)]
 pub fn sobol_u32_at_reversed_index(reversed_index: u32, dimension: usize) -> u32 {
     match dimension {
         0 => reversed_index,
@@ -162,7 +162,7 @@ pub fn sobol_u32_at_reversed_index(reversed_index: u32, dimension: usize) -> u32
 /// is one pass per bit of the exponent: each term whose exponent has bit `s` also adds the
 /// term `s` lower. In the reversed domain, lower exponents are higher bits, hence the left
 /// shifts, and the masks are the reversed ones.
-#[inline]
+#[inline(always)]
 fn second_at_reversed_index(reversed_index: u32) -> u32 {
     let mut y = reversed_index;
     y ^= (y & 0x5555_5555) << 1;
@@ -180,7 +180,7 @@ fn second_at_reversed_index(reversed_index: u32) -> u32 {
 /// Laine and Karras 2011, "Stratified sampling for stochastic transparency",
 /// EGSR; constants from Burley 2020, "Practical Hash-based Owen Scrambling",
 /// JCGT 9(4), Listing 1.
-#[inline]
+#[inline(always)]
 pub fn laine_karras_permutation(mut x: u32, seed: u32) -> u32 {
     x = x.wrapping_add(seed);
     x ^= x.wrapping_mul(0x6c50_b47c);
@@ -195,7 +195,7 @@ pub fn laine_karras_permutation(mut x: u32, seed: u32) -> u32 {
 /// keeps a (t, m, s)-net a (t, m, s)-net (Owen 1995, "Randomly permuted
 /// (t,m,s)-nets and (t,s)-sequences"). Burley 2020, Listing 2: the
 /// Laine–Karras permutation applied to the bit-reversed value.
-#[inline]
+#[inline(always)]
 pub fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
     laine_karras_permutation(x.reverse_bits(), seed).reverse_bits()
 }

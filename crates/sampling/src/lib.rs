@@ -80,6 +80,7 @@ mod pcg_lanes;
 mod quad_light;
 mod sampler;
 mod sampler_kind;
+mod sobol_lanes;
 mod sphere_light;
 mod warp;
 
@@ -97,6 +98,7 @@ pub use quad_light::{
 };
 pub use sampler::{DIMENSIONS_PER_SAMPLE, Sampler};
 pub use sampler_kind::SamplerKind;
+pub use sobol_lanes::SobolXorLanes;
 pub use sphere_light::{
     sample_sphere_light, sample_sphere_light_lanes, sphere_light_pdf, sphere_solid_angle,
 };

@@ -181,7 +181,7 @@ const PERMUTATIONS_4: [[u8; 4]; 24] = [
 /// `hash_key(d)` of the first dimensions (every vertex of a path to depth 30), which every
 /// request of a hashed kind hashes its pixel sample's seed with: made at compile time,
 /// a load instead of a chain of two multiplications per request.
-const DIMENSION_KEYS: [u64; 256] = {
+pub(crate) const DIMENSION_KEYS: [u64; 256] = {
     let mut keys = [0; 256];
     let mut d = 0;
     while d < keys.len() {
@@ -190,6 +190,50 @@ const DIMENSION_KEYS: [u64; 256] = {
     }
     keys
 };
+
+/// `hash_key(dimension)`, from [`DIMENSION_KEYS`] where it holds it.
+#[inline]
+fn dimension_key(dimension: u32) -> u64 {
+    match DIMENSION_KEYS.get(dimension as usize) {
+        Some(&key) => key,
+        None => hash_key(u64::from(dimension)),
+    }
+}
+
+/// The padded Sobol' kinds' numbers: the first `N` (1 or 2) Sobol' dimensions at a
+/// shuffled index, randomized by XOR (`OWEN` false, [`SamplerKind::SobolXor`]) or Owen
+/// scrambling (Burley 2020, Listing 3, in 2D), for the request whose dimension's key is
+/// `key` (`hash_key(dimension)`) in the pixel sample of `pixel_hash` and
+/// `reversed_index` (see [`Sampler`]'s fields). A pure function of them, so that a
+/// path's sampler and a vector of paths' lanes (`SobolXorLanes`) give the same bits.
+#[inline(always)]
+pub(crate) fn padded_sobol<const N: usize, const OWEN: bool>(
+    pixel_hash: u64,
+    reversed_index: u32,
+    key: u64,
+) -> [u32; N] {
+    let h = hash2_keyed(pixel_hash, key);
+    // The index scrambled is `nested_uniform_scramble(index, h)`, kept bit-reversed (the
+    // scramble's last step undone), where dimensions 0 and 1 read it directly.
+    let index = laine_karras_permutation(reversed_index, h as u32);
+    // Dimension by dimension, not over a loop's index: each reads its own matrix inline
+    // (a loop's `k` left the choice of matrix to run time, out of line).
+    // Not a closure: a vector kernel inlines only what is marked to be inlined.
+    #[inline(always)]
+    fn scrambled<const OWEN: bool>(x: u32, seed: u32) -> u32 {
+        if OWEN {
+            nested_uniform_scramble(x, seed)
+        } else {
+            x ^ seed
+        }
+    }
+    let mut out = [0; N];
+    out[0] = scrambled::<OWEN>(sobol_u32_at_reversed_index(index, 0), (h >> 32) as u32);
+    if N == 2 {
+        out[1] = scrambled::<OWEN>(sobol_u32_at_reversed_index(index, 1), hash2(h, 1) as u32);
+    }
+    out
+}
 
 /// Mixed into the seed of replicates past the first, so that their
 /// randomizations are not those of another seed's replicate 0.
@@ -291,6 +335,13 @@ impl Sampler {
     pub fn independent_generator(&self) -> Option<(u64, u64)> {
         (self.kind == SamplerKind::Independent)
             .then(|| (self.rng.state(), (self.rng.stream() << 1) | 1))
+    }
+
+    /// For the default kind, [`SamplerKind::SobolXor`]: the current pixel sample's hash and
+    /// bit-reversed index, from which [`SobolXorLanes`](crate::SobolXorLanes) gives its
+    /// numbers at any dimension. `None` for the other kinds.
+    pub fn sobol_xor_sample(&self) -> Option<(u64, u32)> {
+        (self.kind == SamplerKind::SobolXor).then_some((self.pixel_hash, self.reversed_index))
     }
 
     /// Positions the sampler so that the next value is dimension `dimension`
@@ -436,11 +487,7 @@ impl Sampler {
     /// dimension)`, its first step done once per pixel sample.
     #[inline]
     fn sequence_hash(&self, dimension: u32) -> u64 {
-        let key = match DIMENSION_KEYS.get(dimension as usize) {
-            Some(&key) => key,
-            None => hash_key(u64::from(dimension)),
-        };
-        hash2_keyed(self.pixel_hash, key)
+        hash2_keyed(self.pixel_hash, dimension_key(dimension))
     }
 
     /// Dimension `dimension` of the plain or scrambled Halton or Sobol'
@@ -596,30 +643,16 @@ impl Sampler {
         [x ^ shift as u32, y ^ (shift >> 32) as u32]
     }
 
-    /// The first `N` (1 or 2) Sobol' dimensions at a shuffled index,
-    /// randomized by XOR or Owen scrambling (Burley 2020, Listing 3, in 2D).
+    /// The first `N` (1 or 2) Sobol' dimensions at a shuffled index, randomized by XOR or
+    /// Owen scrambling: [`padded_sobol`] at the current dimension.
     #[inline]
     fn padded_sobol<const N: usize>(&self) -> [u32; N] {
-        let h = self.sequence_hash(self.dimension);
-        // The index scrambled is `nested_uniform_scramble(index, h)`, kept bit-reversed (the
-        // scramble's last step undone), where dimensions 0 and 1 read it directly.
-        let index = laine_karras_permutation(self.reversed_index, h as u32);
-        let seeds = [(h >> 32) as u32, hash2(h, 1) as u32];
-        // Dimension by dimension, not over a loop's index: each reads its own matrix
-        // inline (a loop's `k` left the choice of matrix to run time, out of line).
-        let scrambled = |x: u32, seed: u32| {
-            if self.kind == SamplerKind::SobolXor {
-                x ^ seed
-            } else {
-                nested_uniform_scramble(x, seed)
-            }
-        };
-        let mut out = [0; N];
-        out[0] = scrambled(sobol_u32_at_reversed_index(index, 0), seeds[0]);
-        if N == 2 {
-            out[1] = scrambled(sobol_u32_at_reversed_index(index, 1), seeds[1]);
+        let key = dimension_key(self.dimension);
+        if self.kind == SamplerKind::SobolXor {
+            padded_sobol::<N, false>(self.pixel_hash, self.reversed_index, key)
+        } else {
+            padded_sobol::<N, true>(self.pixel_hash, self.reversed_index, key)
         }
-        out
     }
 
     /// pbrt-v4's `ZSobolSampler::Get1D/Get2D`: Owen-scrambled Sobol' (0, 2)

@@ -3,7 +3,7 @@
 //! formula here is a definition the scalar wave runs at `f32`).
 
 use lueur_materials::CosineScatterLanes;
-use lueur_sampling::{PcgLanes, sample_cosine_hemisphere_lanes};
+use lueur_sampling::{PcgLanes, SobolXorLanes, sample_cosine_hemisphere_lanes};
 use lueur_scene::Light;
 use lueur_sdf_math::{GroupRays, Lane, LaneKernel, LaneVec3, TraceParams, resolving_lanes};
 
@@ -11,7 +11,7 @@ use super::rows::{self, Block, LANES, ld, ld_mask, ld3, select3, st, st_mask, st
 use crate::geometry::Geometry;
 use crate::next_event::{AimedSphereLanes, DiffuseLanes, all_zero, sphere_next_event_lanes};
 use crate::roulette::roulette_lanes;
-use crate::strategy::{DIMS_PER_VERTEX, VertexSample};
+use crate::strategy::{DIMS_PER_VERTEX, VertexSample, vertex_dimension};
 use crate::trace::{CountLanes, RayCounters, TraceCounters, nearest_light_lanes};
 
 /// The lanes whose next-event estimate found a shadow ray to trace (`rows::NEE` 1).
@@ -118,15 +118,26 @@ impl LaneKernel for PathRays<'_> {
     }
 }
 
-/// The numbers of every vertex shaded this round (`rows::SHADE`), for the independent
-/// kind: each lane's generator stepped over the vertex's dimensions, the numbers taken at
-/// the dimensions `VertexSample::draw` reads them from. Numbers the vertex does not read
-/// are written too (no kernel reads them: a mirror's, or roulette's before it applies),
-/// and the generators stand at the next vertex's first dimension after. Blocks with no
-/// vertex to shade are left as they are.
+/// The numbers of every vertex shaded this round (`rows::SHADE`), drawn for a block of
+/// paths at once into the rows `VertexSample::draw` fills, at the dimensions it takes them
+/// from (`VertexSample::*_DIM`). Numbers the vertex does not read are written too (no
+/// kernel reads them: a mirror's, or roulette's before it applies). Blocks with no vertex
+/// to shade are left as they are.
 pub(super) struct VertexNumbers<'a> {
     pub blocks: &'a mut [Block],
-    pub generators: &'a mut [PcgLanes<LANES>],
+    pub numbers: LaneNumbers<'a>,
+}
+
+/// Where a block's paths' numbers come from, per sampler kind drawn in lanes.
+pub(super) enum LaneNumbers<'a> {
+    /// The independent kind's generators, stepped over each vertex's
+    /// [`DIMS_PER_VERTEX`] dimensions: each lane's stands at its vertex's first (the
+    /// vertex numbers are the only ones a path draws after its camera's), and a number
+    /// no one reads is drawn too, so that the next vertex starts where it should.
+    Independent(&'a mut [PcgLanes<LANES>]),
+    /// The default kind's pixel samples, each number hashed at its lane's dimension
+    /// (from its vertex's depth, `rows::DEPTH`).
+    SobolXor(&'a [SobolXorLanes<LANES>]),
 }
 
 impl LaneKernel for VertexNumbers<'_> {
@@ -134,19 +145,43 @@ impl LaneKernel for VertexNumbers<'_> {
 
     #[inline(always)]
     fn run<V: Lane>(self) {
-        for (b, generators) in self.blocks.iter_mut().zip(self.generators.iter_mut()) {
-            if b[rows::SHADE].iter().all(|&shade| shade == 0.0) {
-                continue;
+        let VertexNumbers { blocks, numbers } = self;
+        match numbers {
+            LaneNumbers::Independent(generators) => {
+                for (b, generators) in blocks.iter_mut().zip(generators.iter_mut()) {
+                    if b[rows::SHADE].iter().all(|&shade| shade == 0.0) {
+                        continue;
+                    }
+                    let mut numbers = [[0.0; LANES]; DIMS_PER_VERTEX as usize];
+                    for number in &mut numbers {
+                        *number = generators.next_1d();
+                    }
+                    b[rows::U_EMITTER] = numbers[VertexSample::EMITTER_DIM];
+                    b[rows::U_EMITTER + 1] = numbers[VertexSample::EMITTER_DIM + 1];
+                    b[rows::U_BSDF] = numbers[VertexSample::BSDF_DIM];
+                    b[rows::U_BSDF + 1] = numbers[VertexSample::BSDF_DIM + 1];
+                    b[rows::U_ROULETTE] = numbers[VertexSample::ROULETTE_DIM];
+                }
             }
-            let mut numbers = [[0.0; LANES]; DIMS_PER_VERTEX as usize];
-            for number in &mut numbers {
-                *number = generators.next_1d();
+            LaneNumbers::SobolXor(samples) => {
+                for (b, samples) in blocks.iter_mut().zip(samples) {
+                    if b[rows::SHADE].iter().all(|&shade| shade == 0.0) {
+                        continue;
+                    }
+                    // Each lane's dimensions of the three requests (no closures: a vector
+                    // kernel inlines only what is marked to be inlined).
+                    let mut dims = [[0u32; LANES]; 3];
+                    for (l, &depth) in b[rows::DEPTH].iter().enumerate() {
+                        let first = vertex_dimension(depth as u32);
+                        dims[0][l] = first + VertexSample::EMITTER_DIM as u32;
+                        dims[1][l] = first + VertexSample::BSDF_DIM as u32;
+                        dims[2][l] = first + VertexSample::ROULETTE_DIM as u32;
+                    }
+                    [b[rows::U_EMITTER], b[rows::U_EMITTER + 1]] = samples.get_2d(&dims[0]);
+                    [b[rows::U_BSDF], b[rows::U_BSDF + 1]] = samples.get_2d(&dims[1]);
+                    b[rows::U_ROULETTE] = samples.get_1d(&dims[2]);
+                }
             }
-            b[rows::U_EMITTER] = numbers[VertexSample::EMITTER_DIM];
-            b[rows::U_EMITTER + 1] = numbers[VertexSample::EMITTER_DIM + 1];
-            b[rows::U_BSDF] = numbers[VertexSample::BSDF_DIM];
-            b[rows::U_BSDF + 1] = numbers[VertexSample::BSDF_DIM + 1];
-            b[rows::U_ROULETTE] = numbers[VertexSample::ROULETTE_DIM];
         }
     }
 }

@@ -10,7 +10,8 @@
 //! rebuilt"). Here the path state is the rows: blocks of 16 paths, a field per row
 //! ([`rows`]), that each stage's kernel ([`kernels`]) loads and stores a vector at a time.
 //! What stays scalar, per lane, is what branches by path: the numbers of the samplers other
-//! than the independent kind (whose generators step in lanes, `PcgLanes`), the shading
+//! than the independent and default kinds (which are drawn in lanes, `PcgLanes` and
+//! `SobolXorLanes`), the shading
 //! points (`SurfacePoint::at_source`, grouped by object, from and to the rows), emission
 //! found on a light, a mirror's bounce, and the paths that end and start.
 //!
@@ -29,11 +30,11 @@ use std::time::Instant;
 
 use glam::{Vec2, Vec3};
 use lueur_materials::Material;
-use lueur_sampling::{PcgLanes, Sampler, SamplerKind};
+use lueur_sampling::{PcgLanes, Sampler, SamplerKind, SobolXorLanes};
 use lueur_scene::{Light, Marching, Strategy};
 use lueur_sdf_math::{Ray, TraceOutcome, TraceParams};
 
-use self::kernels::{PathRays, Scatter, Shade, ShadowRays, VertexNumbers};
+use self::kernels::{LaneNumbers, PathRays, Scatter, Shade, ShadowRays, VertexNumbers};
 use self::rows::{Block, LANES, get3, set3};
 use crate::Hit;
 use crate::next_event::AimedSphereLanes;
@@ -107,6 +108,8 @@ pub(crate) struct LaneScratch {
     blocks: Vec<Block>,
     /// Each block's generators, where the independent kind's numbers are drawn in lanes.
     generators: Vec<PcgLanes<LANES>>,
+    /// Each block's pixel samples, where the default kind's numbers are drawn in lanes.
+    sobol: Vec<SobolXorLanes<LANES>>,
     slots: Vec<Option<Slot>>,
     ended: VecDeque<Option<(SampleId, Vec3)>>,
     /// The lanes whose hit is shaded this round, and the object each hit.
@@ -143,11 +146,16 @@ pub(crate) fn radiance_lanes(
     let blocks = width.max(1).div_ceil(LANES);
     s.blocks.clear();
     s.blocks.resize(blocks, rows::EMPTY);
-    // The independent kind's numbers are drawn for a vector of paths at once
+    // The independent and default kinds' numbers are drawn for a vector of paths at once
     // (`VertexNumbers`); the other kinds' by each path's sampler.
-    let numbers_in_lanes = settings.sampler == SamplerKind::Independent;
+    let numbers_in_lanes = matches!(
+        settings.sampler,
+        SamplerKind::Independent | SamplerKind::SobolXor
+    );
     s.generators.clear();
     s.generators.resize(blocks, PcgLanes::UNSET);
+    s.sobol.clear();
+    s.sobol.resize(blocks, SobolXorLanes::UNSET);
     s.slots.clear();
     s.slots.resize_with(blocks * LANES, || None);
     s.ended.clear();
@@ -170,6 +178,9 @@ pub(crate) fn radiance_lanes(
             start(&mut s.blocks[lane / LANES], lane % LANES, ray);
             if let Some(generator) = sampler.independent_generator() {
                 s.generators[lane / LANES].set(lane % LANES, generator);
+            }
+            if let Some(sample) = sampler.sobol_xor_sample() {
+                s.sobol[lane / LANES].set(lane % LANES, sample);
             }
             s.slots[lane] = Some(Slot {
                 id,
@@ -301,9 +312,14 @@ pub(crate) fn radiance_lanes(
         }
         if numbers_in_lanes {
             // The level is available: `or_widest` says so.
+            let numbers = if settings.sampler == SamplerKind::SobolXor {
+                LaneNumbers::SobolXor(&s.sobol)
+            } else {
+                LaneNumbers::Independent(&mut s.generators)
+            };
             let _ = level.dispatch(VertexNumbers {
                 blocks: &mut s.blocks,
-                generators: &mut s.generators,
+                numbers,
             });
         }
         clock.lap(Stage::VertexNumbers);
