@@ -94,11 +94,9 @@ impl LaneWave {
     }
 }
 
-/// A lane's path beside its rows: the sample it estimates, its own copy of the sampler,
-/// and the order it started in.
+/// A lane's path beside its rows: the sample it estimates and the order it started in.
 struct Slot {
     id: SampleId,
-    sampler: Sampler,
     ordinal: u64,
 }
 
@@ -111,6 +109,9 @@ pub(crate) struct LaneScratch {
     /// Each block's pixel samples, where the default kind's numbers are drawn in lanes.
     sobol: Vec<SobolXorLanes<LANES>>,
     slots: Vec<Option<Slot>>,
+    /// Each lane's path's own copy of the sampler, where its numbers are drawn by it (not
+    /// in lanes): kept apart from the slots, which are then a few words to start and end.
+    samplers: Vec<Option<Sampler>>,
     ended: VecDeque<Option<(SampleId, Vec3)>>,
     /// The lanes whose hit is shaded this round, and the object each hit.
     lanes: Vec<usize>,
@@ -158,6 +159,8 @@ pub(crate) fn radiance_lanes(
     s.sobol.resize(blocks, SobolXorLanes::UNSET);
     s.slots.clear();
     s.slots.resize_with(blocks * LANES, || None);
+    s.samplers.clear();
+    s.samplers.resize_with(blocks * LANES, || None);
     s.ended.clear();
     s.vacant.clear();
     s.vacant.extend((0..blocks * LANES).rev());
@@ -182,9 +185,11 @@ pub(crate) fn radiance_lanes(
             if let Some(sample) = sampler.sobol_xor_sample() {
                 s.sobol[lane / LANES].set(lane % LANES, sample);
             }
+            if !numbers_in_lanes {
+                s.samplers[lane] = Some(sampler);
+            }
             s.slots[lane] = Some(Slot {
                 id,
-                sampler,
                 ordinal: started,
             });
             started += 1;
@@ -212,8 +217,7 @@ pub(crate) fn radiance_lanes(
         // What each path found, and the numbers of each vertex that scatters.
         s.lanes.clear();
         s.objects.clear();
-        // The live lanes, found by their rows (a slot, with its sampler, is large, and the
-        // independent kind's numbers never read it).
+        // The live lanes, found by their rows rather than by their slots.
         for lane in lanes_where(&s.blocks, rows::ALIVE, &mut s.masks) {
             let b = &mut s.blocks[lane / LANES];
             let l = lane % LANES;
@@ -290,10 +294,11 @@ pub(crate) fn radiance_lanes(
             if numbers_in_lanes {
                 continue;
             }
-            let slot = s.slots[lane].as_mut().expect("a live lane's path");
+            let slot = s.slots[lane].as_ref().expect("a live lane's path");
+            let sampler = s.samplers[lane].as_mut().expect("a path's own sampler");
             let mut u = VertexSample::UNSET;
             u.draw(
-                &mut slot.sampler,
+                sampler,
                 slot.id.pixel,
                 slot.id.index,
                 depth,
