@@ -28,7 +28,12 @@
 //! `f64x4`, with its `atan2` and `sin_cos`), and [`SphericalRectangle`] is one lane of
 //! it. `wide` chooses its instructions when it is compiled, so every dispatch level of a
 //! binary gives the same bits; a build for another CPU (`-C target-cpu`, where `wide`
-//! then fuses multiply-adds) or another architecture may round differently.
+//! then fuses multiply-adds) or another architecture may round differently. The
+//! sampler's numbers for a vector of paths at once are arrays stepped by one loop, which
+//! a caller compiled for a SIMD level vectorizes: the independent kind's generators
+//! ([`PcgLanes`]) and the default kind's pixel samples ([`SobolXorLanes`], through the
+//! same `padded_sobol` function the [`Sampler`] calls), each lane the bits of its path's
+//! sampler.
 //!
 //! **Contract.** Every warp's samples follow its pdf (checked by chi-square
 //! goodness-of-fit tests); every pdf is finite and `>= 0`; no NaN or infinity
