@@ -580,6 +580,14 @@ fn report(
     )?;
     writeln!(
         md,
+        "Machine: {}, {} cores ({}); commit {}.\n",
+        crate::speed::cpu_model(),
+        std::thread::available_parallelism().map_or(0, std::num::NonZero::get),
+        crate::speed::simd_features(),
+        crate::speed::commit()
+    )?;
+    writeln!(
+        md,
         "| configuration | spp | time | M samples/s | MSE | MSE x time |"
     )?;
     writeln!(md, "|---|---|---|---|---|---|")?;

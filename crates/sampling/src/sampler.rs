@@ -216,8 +216,6 @@ pub(crate) fn padded_sobol<const N: usize, const OWEN: bool>(
     // The index scrambled is `nested_uniform_scramble(index, h)`, kept bit-reversed (the
     // scramble's last step undone), where dimensions 0 and 1 read it directly.
     let index = laine_karras_permutation(reversed_index, h as u32);
-    // Dimension by dimension, not over a loop's index: each reads its own matrix inline
-    // (a loop's `k` left the choice of matrix to run time, out of line).
     // Not a closure: a vector kernel inlines only what is marked to be inlined.
     #[inline(always)]
     fn scrambled<const OWEN: bool>(x: u32, seed: u32) -> u32 {
@@ -227,6 +225,8 @@ pub(crate) fn padded_sobol<const N: usize, const OWEN: bool>(
             x ^ seed
         }
     }
+    // Dimension by dimension, not over a loop's index: each reads its own matrix inline
+    // (a loop's `k` left the choice of matrix to run time, out of line).
     let mut out = [0; N];
     out[0] = scrambled::<OWEN>(sobol_u32_at_reversed_index(index, 0), (h >> 32) as u32);
     if N == 2 {

@@ -147,9 +147,9 @@ pub type RayClip = RayClipLanes<f32>;
 #[derive(Clone, Copy, Debug)]
 struct Slope<L: Lane> {
     /// `-1 / slope` (negated once here rather than each root's numerator at every box,
-    /// which is the same product), with a zero slope replaced by a tiny positive one, so that
-    /// `a + 0 t < 0` comes out as "every t" for negative `a` and "none" for positive `a`
-    /// with no special case.
+    /// which is the same product), with a zero slope replaced by a tiny positive one, so
+    /// that `a + 0 t < 0` comes out as "every t" for negative `a` and "none" for positive
+    /// `a` with no special case.
     neg_inv: LaneVec3<L>,
     /// Where the slope is positive: the set is `t < root`; elsewhere `t > root`.
     rising: [L::Mask; 3],
@@ -174,9 +174,10 @@ impl<L: Lane> Slope<L> {
 
     /// On axis `axis`, the half-line `{t : alpha + slope t < 0}` as `(lo, hi)`, the other
     /// end infinite. A NaN root bounds nothing: [`box_axis`] folds each end in with
-    /// `max_cmp` or `min_cmp`, which drop a NaN in either place. Not clipped to the trace's range nor
-    /// tested for emptiness here: the box intersects it with the other face's half-line
-    /// and then clips once, which is the same interval for half the work.
+    /// `max_cmp` or `min_cmp`, which drop a NaN in either place. Neither clipped to the
+    /// trace's range nor tested for emptiness here: the box intersects it with the other
+    /// face's half-line and then clips once, the same interval for half the work (an
+    /// empty half-line leaves the intersection empty).
     #[inline(always)]
     fn below(&self, axis: usize, alpha: L) -> (L, L) {
         let (neg_inv, rising) = (component(self.neg_inv, axis), self.rising[axis]);

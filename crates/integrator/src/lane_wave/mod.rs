@@ -11,16 +11,17 @@
 //! ([`rows`]), that each stage's kernel ([`kernels`]) loads and stores a vector at a time.
 //! What stays scalar, per lane, is what branches by path: the numbers of the samplers other
 //! than the independent and default kinds (which are drawn in lanes, `PcgLanes` and
-//! `SobolXorLanes`), the shading
-//! points (`SurfacePoint::at_source`, grouped by object, from and to the rows), emission
-//! found on a light, a mirror's bounce, and the paths that end and start.
+//! `SobolXorLanes`), the shading points (`SurfacePoint::at_source`, grouped by object, from
+//! and to the rows), emission found on a light, a mirror's bounce, and the paths that end
+//! and start.
 //!
 //! Contract: the image is the wave of `path.rs`'s, bit for bit, on every SIMD level, for
 //! any number of paths in flight and threads. Each lane runs the scalar wave's own
 //! definitions (the march [`Geometry::march_vector`], `Light::intersect_lanes`,
 //! `sample_sphere_light_lanes`, `NextEventLanes`, `ShadowAim`, `CosineScatterLanes`,
-//! `roulette_lanes`), which the scalar wave runs at `f32`, and the independent kind's numbers
-//! from `PcgLanes`, which its tests hold to `Sampler`; `tests/` holds both waves to it.
+//! `roulette_lanes`), which the scalar wave runs at `f32`, and the independent and default
+//! kinds' numbers from `PcgLanes` and `SobolXorLanes`, which their tests hold to `Sampler`;
+//! `tests/` holds both waves to it.
 
 mod kernels;
 mod rows;
