@@ -81,11 +81,11 @@ mod frame;
 mod light;
 mod math;
 mod mis;
+mod padded_sobol;
 mod pcg_lanes;
 mod quad_light;
 mod sampler;
 mod sampler_kind;
-mod sobol_lanes;
 mod sphere_light;
 mod warp;
 
@@ -96,6 +96,7 @@ pub use frame::{Frame, FrameLanes};
 pub use light::{DirectionSample, DirectionSampleLanes};
 pub use math::ONE_MINUS_EPSILON;
 pub use mis::{balance_heuristic, power_heuristic, power_heuristic_lanes};
+pub use padded_sobol::SobolXorLanes;
 pub use pcg_lanes::PcgLanes;
 pub use quad_light::{
     RECTANGLE_LANES, RectangleFrame, SphericalRectangle, SphericalRectangles, polygon_irradiance,
@@ -103,7 +104,6 @@ pub use quad_light::{
 };
 pub use sampler::{DIMENSIONS_PER_SAMPLE, Sampler};
 pub use sampler_kind::SamplerKind;
-pub use sobol_lanes::SobolXorLanes;
 pub use sphere_light::{
     sample_sphere_light, sample_sphere_light_lanes, sphere_light_pdf, sphere_solid_angle,
 };

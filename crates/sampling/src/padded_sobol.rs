@@ -1,8 +1,48 @@
-//! The default kind's numbers for a vector of paths at once: [`SobolXorLanes`].
+//! The padded Sobol' kinds' numbers ([`padded_sobol`]), for one request of a path's
+//! [`Sampler`](crate::Sampler) or for a vector of paths at once ([`SobolXorLanes`]): one
+//! formula for both.
 
-use lueur_pointsets::construct::hash_key;
+use lueur_pointsets::construct::{hash_key, hash2, hash2_keyed};
+use lueur_pointsets::{
+    laine_karras_permutation, nested_uniform_scramble, sobol_u32_at_reversed_index,
+};
 
-use crate::sampler::{DIMENSION_KEYS, fraction_to_f32, padded_sobol};
+use crate::sampler::{DIMENSION_KEYS, fraction_to_f32};
+
+/// The padded Sobol' kinds' numbers: the first `N` (1 or 2) Sobol' dimensions at a
+/// shuffled index, randomized by XOR (`OWEN` false, [`SamplerKind::SobolXor`](crate::SamplerKind::SobolXor)) or Owen
+/// scrambling (Burley 2020, Listing 3, in 2D), for the request whose dimension's key is
+/// `key` (`hash_key(dimension)`) in the pixel sample of `pixel_hash` and
+/// `reversed_index` (see [`Sampler`](crate::Sampler)'s fields). A pure function of them, so that a
+/// path's sampler and a vector of paths' lanes (`SobolXorLanes`) give the same bits.
+#[inline(always)]
+pub(crate) fn padded_sobol<const N: usize, const OWEN: bool>(
+    pixel_hash: u64,
+    reversed_index: u32,
+    key: u64,
+) -> [u32; N] {
+    let h = hash2_keyed(pixel_hash, key);
+    // The index scrambled is `nested_uniform_scramble(index, h)`, kept bit-reversed (the
+    // scramble's last step undone), where dimensions 0 and 1 read it directly.
+    let index = laine_karras_permutation(reversed_index, h as u32);
+    // Not a closure: a vector kernel inlines only what is marked to be inlined.
+    #[inline(always)]
+    fn scrambled<const OWEN: bool>(x: u32, seed: u32) -> u32 {
+        if OWEN {
+            nested_uniform_scramble(x, seed)
+        } else {
+            x ^ seed
+        }
+    }
+    // Dimension by dimension, not over a loop's index: each reads its own matrix inline
+    // (a loop's `k` left the choice of matrix to run time, out of line).
+    let mut out = [0; N];
+    out[0] = scrambled::<OWEN>(sobol_u32_at_reversed_index(index, 0), (h >> 32) as u32);
+    if N == 2 {
+        out[1] = scrambled::<OWEN>(sobol_u32_at_reversed_index(index, 1), hash2(h, 1) as u32);
+    }
+    out
+}
 
 /// `N` pixel samples of [`SamplerKind::SobolXor`](crate::SamplerKind::SobolXor), one per
 /// lane, each kept as the two words its numbers depend on besides the dimension (the
