@@ -10,11 +10,12 @@ use lueur_pointsets::{
 use crate::sampler::{DIMENSION_KEYS, fraction_to_f32};
 
 /// The padded Sobol' kinds' numbers: the first `N` (1 or 2) Sobol' dimensions at a
-/// shuffled index, randomized by XOR (`OWEN` false, [`SamplerKind::SobolXor`](crate::SamplerKind::SobolXor)) or Owen
-/// scrambling (Burley 2020, Listing 3, in 2D), for the request whose dimension's key is
-/// `key` (`hash_key(dimension)`) in the pixel sample of `pixel_hash` and
-/// `reversed_index` (see [`Sampler`](crate::Sampler)'s fields). A pure function of them, so that a
-/// path's sampler and a vector of paths' lanes (`SobolXorLanes`) give the same bits.
+/// shuffled index, randomized by XOR (`OWEN` false,
+/// [`SamplerKind::SobolXor`](crate::SamplerKind::SobolXor)) or Owen scrambling (Burley
+/// 2020, Listing 3, in 2D), for the request whose dimension's key is `key`
+/// (`hash_key(dimension)`) in the pixel sample of `pixel_hash` and `reversed_index` (see
+/// [`Sampler`](crate::Sampler)'s fields). A pure function of them, so that a path's
+/// sampler and a vector of paths' lanes ([`SobolXorLanes`]) give the same bits.
 #[inline(always)]
 pub(crate) fn padded_sobol<const N: usize, const OWEN: bool>(
     pixel_hash: u64,
